@@ -1,0 +1,1 @@
+//! # agent: the ivlmap language layer (work in progress)

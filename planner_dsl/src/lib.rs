@@ -1,0 +1,1 @@
+//! # planner_dsl: the sandboxed plan language (work in progress)
