@@ -22,10 +22,12 @@ impl Point {
         self.x.is_finite() && self.y.is_finite()
     }
 
+    #[allow(clippy::should_implement_trait)] // also implemented; the method reads better in chains
     pub fn add(self, o: Point) -> Point {
         Point::new(self.x + o.x, self.y + o.y)
     }
 
+    #[allow(clippy::should_implement_trait)]
     pub fn sub(self, o: Point) -> Point {
         Point::new(self.x - o.x, self.y - o.y)
     }
@@ -57,6 +59,27 @@ impl Point {
     pub fn from_heading(heading_deg: f64) -> Point {
         let r = heading_deg.to_radians();
         Point::new(r.sin(), r.cos())
+    }
+}
+
+impl std::ops::Add for Point {
+    type Output = Point;
+    fn add(self, o: Point) -> Point {
+        Point::new(self.x + o.x, self.y + o.y)
+    }
+}
+
+impl std::ops::Sub for Point {
+    type Output = Point;
+    fn sub(self, o: Point) -> Point {
+        Point::new(self.x - o.x, self.y - o.y)
+    }
+}
+
+impl std::ops::Mul<f64> for Point {
+    type Output = Point;
+    fn mul(self, s: f64) -> Point {
+        Point::new(self.x * s, self.y * s)
     }
 }
 
@@ -92,7 +115,10 @@ pub struct Pose {
 
 impl Pose {
     pub fn new(x: f64, y: f64, heading: f64) -> Self {
-        Self { position: Point::new(x, y), heading: normalize_heading(heading) }
+        Self {
+            position: Point::new(x, y),
+            heading: normalize_heading(heading),
+        }
     }
 
     /// `[x, y, heading]`, the form the file formats use.
@@ -121,7 +147,10 @@ pub struct Aabb {
 impl Aabb {
     pub fn from_points(pts: &[Point]) -> Option<Aabb> {
         let first = *pts.first()?;
-        let mut b = Aabb { min: first, max: first };
+        let mut b = Aabb {
+            min: first,
+            max: first,
+        };
         for p in &pts[1..] {
             b.min.x = b.min.x.min(p.x);
             b.min.y = b.min.y.min(p.y);
@@ -132,7 +161,10 @@ impl Aabb {
     }
 
     pub fn center(&self) -> Point {
-        Point::new((self.min.x + self.max.x) / 2.0, (self.min.y + self.max.y) / 2.0)
+        Point::new(
+            (self.min.x + self.max.x) / 2.0,
+            (self.min.y + self.max.y) / 2.0,
+        )
     }
 
     pub fn width(&self) -> f64 {
@@ -243,7 +275,8 @@ impl Polygon {
         if self.contains(p) {
             return 0.0;
         }
-        self.closest_boundary_point(p).map_or(f64::INFINITY, |q| q.dist(p))
+        self.closest_boundary_point(p)
+            .map_or(f64::INFINITY, |q| q.dist(p))
     }
 }
 

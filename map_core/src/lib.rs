@@ -19,6 +19,19 @@
 
 mod geometry;
 mod grid;
+mod map;
+mod matcher;
+mod query;
+mod scene;
 
-pub use crate::geometry::{closest_on_segment, normalize_heading, oriented_rect, Aabb, Point, Polygon, Pose};
+pub use crate::geometry::{
+    closest_on_segment, normalize_heading, oriented_rect, Aabb, Point, Polygon, Pose,
+};
 pub use crate::grid::{Cell, Grid, GridFrame};
+pub use crate::map::{Instance, IvlMap, Region};
+pub use crate::matcher::{
+    canonical, is_colour_word, normalize, plural, singular, LexicalMatcher, NameMatcher,
+    COLOUR_WORDS,
+};
+pub use crate::query::{ordinal_word, ObjectOrder, QueryError};
+pub use crate::scene::{Scene, SceneError, SceneLocation, SceneObject, SCENE_FORMAT};

@@ -1,0 +1,489 @@
+//! Instance queries: "the k-th (colour) (name) in (order)", and region lookup.
+//! The semantics the function library's `get_obj_attributes` relies on (design.md).
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::Pose;
+use crate::map::{Instance, IvlMap, Region};
+use crate::matcher::{canonical, is_colour_word, plural, LexicalMatcher, NameMatcher};
+
+/// The order in which "the k-th" counts instances.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectOrder {
+    /// By distance from the robot to the footprint, nearest first (the default).
+    #[default]
+    NearToFar,
+    FarToNear,
+    /// By lateral offset of the footprint centre in the robot's current frame.
+    LeftToRight,
+    RightToLeft,
+    /// By the footprint centre's world coordinates.
+    NorthToSouth,
+    SouthToNorth,
+    WestToEast,
+    EastToWest,
+}
+
+impl ObjectOrder {
+    /// Every order with its name.
+    pub const ALL: [(ObjectOrder, &'static str); 8] = [
+        (ObjectOrder::NearToFar, "near_to_far"),
+        (ObjectOrder::FarToNear, "far_to_near"),
+        (ObjectOrder::LeftToRight, "left_to_right"),
+        (ObjectOrder::RightToLeft, "right_to_left"),
+        (ObjectOrder::NorthToSouth, "north_to_south"),
+        (ObjectOrder::SouthToNorth, "south_to_north"),
+        (ObjectOrder::WestToEast, "west_to_east"),
+        (ObjectOrder::EastToWest, "east_to_west"),
+    ];
+
+    /// Parse an order name; "", "default" and "nearest" mean [`ObjectOrder::NearToFar`].
+    /// Spaces, hyphens and case are forgiven ("Left to right").
+    pub fn parse(s: &str) -> Result<ObjectOrder, QueryError> {
+        let n = s.trim().to_lowercase().replace([' ', '-'], "_");
+        if n.is_empty() || n == "default" || n == "nearest" || n == "distance" {
+            return Ok(ObjectOrder::NearToFar);
+        }
+        ObjectOrder::ALL
+            .iter()
+            .find(|(_, name)| *name == n)
+            .map(|(o, _)| *o)
+            .ok_or_else(|| QueryError::UnknownOrder {
+                order: s.to_string(),
+            })
+    }
+
+    pub fn name(self) -> &'static str {
+        ObjectOrder::ALL
+            .iter()
+            .find(|(o, _)| *o == self)
+            .map_or("near_to_far", |(_, n)| n)
+    }
+
+    /// The sort key of an instance for this order (ascending = first).
+    fn key(self, inst: &Instance, robot: Pose) -> f64 {
+        let c = inst.center();
+        match self {
+            ObjectOrder::NearToFar => inst.distance(robot.position),
+            ObjectOrder::FarToNear => -inst.distance(robot.position),
+            ObjectOrder::LeftToRight => c.sub(robot.position).dot(robot.right()),
+            ObjectOrder::RightToLeft => -c.sub(robot.position).dot(robot.right()),
+            ObjectOrder::NorthToSouth => -c.y,
+            ObjectOrder::SouthToNorth => c.y,
+            ObjectOrder::WestToEast => c.x,
+            ObjectOrder::EastToWest => -c.x,
+        }
+    }
+}
+
+impl fmt::Display for ObjectOrder {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// "1st", "2nd", "3rd", "11th", "last".
+pub fn ordinal_word(k: i64) -> String {
+    if k == -1 {
+        return "last".into();
+    }
+    let suffix = match (k % 10, k % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{k}{suffix}")
+}
+
+/// A query that the map cannot answer; the message says what the map holds.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum QueryError {
+    #[error("the map has no {name:?}; it holds {}", holds(.known))]
+    UnknownObject {
+        name: String,
+        known: Vec<(String, usize)>,
+    },
+    #[error("there is no {colour} {name}; {}", colour_summary(.name, .available))]
+    NoSuchColour {
+        name: String,
+        colour: String,
+        available: Vec<(Option<String>, usize)>,
+    },
+    #[error("{colour:?} is not a colour (asked for the {colour} {name}); colours here are {}", .known.join(", "))]
+    NotAColour {
+        name: String,
+        colour: String,
+        known: Vec<String>,
+    },
+    #[error("there {} {count} {what}; asked for the {}", if *.count == 1 { "is" } else { "are" }, ordinal_word(*.k))]
+    OrdinalPastCount { what: String, count: usize, k: i64 },
+    #[error(
+        "ordinal {k} is not valid: use k >= 1 for the k-th, 0 for the nearest, -1 for the last"
+    )]
+    BadOrdinal { k: i64 },
+    #[error("unknown order {order:?}; use one of near_to_far, far_to_near, left_to_right, right_to_left, north_to_south, south_to_north, west_to_east, east_to_west")]
+    UnknownOrder { order: String },
+    #[error("the map has no region {name:?}; regions here are {}", if .known.is_empty() { "none".to_string() } else { .known.join(", ") })]
+    UnknownRegion { name: String, known: Vec<String> },
+    #[error("the map has no instance with id {id}")]
+    UnknownInstance { id: u32 },
+}
+
+fn holds(known: &[(String, usize)]) -> String {
+    if known.is_empty() {
+        return "no objects".into();
+    }
+    known
+        .iter()
+        .map(|(l, n)| {
+            if *n == 1 {
+                format!("1 {l}")
+            } else {
+                format!("{n} {}", plural(l))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn colour_summary(name: &str, available: &[(Option<String>, usize)]) -> String {
+    let total: usize = available.iter().map(|(_, n)| n).sum();
+    let noun = if total == 1 {
+        name.to_string()
+    } else {
+        plural(name)
+    };
+    let parts: Vec<String> = available
+        .iter()
+        .map(|(c, n)| format!("{n} {}", c.as_deref().unwrap_or("of unknown colour")))
+        .collect();
+    format!(
+        "the {noun} here {}: {}",
+        if total == 1 { "is" } else { "are" },
+        parts.join(", ")
+    )
+}
+
+impl IvlMap {
+    /// `get_obj_attributes(name, k, colour, order)` with the built-in lexical matcher.
+    ///
+    /// Picks among instances whose label matches `name` and (if `colour` is given and
+    /// not empty) whose colour matches it. `k == 0` = the first in the order
+    /// (by default the nearest), `k >= 1` = the k-th, `k == -1` = the last.
+    pub fn get_obj_attributes(
+        &self,
+        name: &str,
+        k: i64,
+        colour: Option<&str>,
+        order: ObjectOrder,
+        robot: Pose,
+    ) -> Result<&Instance, QueryError> {
+        self.get_obj_attributes_with(&LexicalMatcher, name, k, colour, order, robot)
+    }
+
+    /// [`IvlMap::get_obj_attributes`] with a chosen [`NameMatcher`].
+    pub fn get_obj_attributes_with(
+        &self,
+        matcher: &dyn NameMatcher,
+        name: &str,
+        k: i64,
+        colour: Option<&str>,
+        order: ObjectOrder,
+        robot: Pose,
+    ) -> Result<&Instance, QueryError> {
+        if k < -1 {
+            return Err(QueryError::BadOrdinal { k });
+        }
+        let labels: Vec<&str> = {
+            let mut v: Vec<&str> = self.instances.iter().map(|i| i.label.as_str()).collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        };
+        let label = matcher
+            .best(name, &labels)
+            .ok_or_else(|| QueryError::UnknownObject {
+                name: name.trim().to_string(),
+                known: self.label_counts(),
+            })?;
+        let same: Vec<&Instance> = self.instances.iter().filter(|i| i.label == label).collect();
+        let colour = colour.map(str::trim).filter(|c| !c.is_empty());
+        let mut cands: Vec<&Instance> = match colour {
+            None => same.clone(),
+            Some(c) => {
+                let want = canonical(c);
+                same.iter()
+                    .copied()
+                    .filter(|i| i.color.as_deref().is_some_and(|ic| canonical(ic) == want))
+                    .collect()
+            }
+        };
+        if cands.is_empty() {
+            let c = colour.unwrap_or_default();
+            let map_colours: Vec<String> = self.colours.clone();
+            if !is_colour_word(c) && !map_colours.iter().any(|m| canonical(m) == canonical(c)) {
+                return Err(QueryError::NotAColour {
+                    name: label.to_string(),
+                    colour: c.to_string(),
+                    known: map_colours,
+                });
+            }
+            let mut available: Vec<(Option<String>, usize)> = Vec::new();
+            for i in &same {
+                match available.iter_mut().find(|(col, _)| *col == i.color) {
+                    Some((_, n)) => *n += 1,
+                    None => available.push((i.color.clone(), 1)),
+                }
+            }
+            available.sort_by(|a, b| (a.0.is_none(), &a.0).cmp(&(b.0.is_none(), &b.0)));
+            return Err(QueryError::NoSuchColour {
+                name: label.to_string(),
+                colour: c.to_string(),
+                available,
+            });
+        }
+        cands.sort_by(|a, b| {
+            order
+                .key(a, robot)
+                .total_cmp(&order.key(b, robot))
+                .then(a.id.cmp(&b.id))
+        });
+        let idx = match k {
+            -1 => cands.len() - 1,
+            0 => 0,
+            k => (k - 1) as usize,
+        };
+        cands.get(idx).copied().ok_or_else(|| {
+            let what = match colour {
+                Some(c) => format!(
+                    "{c} {}",
+                    if cands.len() == 1 {
+                        label.to_string()
+                    } else {
+                        plural(label)
+                    }
+                ),
+                None => {
+                    if cands.len() == 1 {
+                        label.to_string()
+                    } else {
+                        plural(label)
+                    }
+                }
+            };
+            QueryError::OrdinalPastCount {
+                what,
+                count: cands.len(),
+                k,
+            }
+        })
+    }
+
+    /// The region named `name` (case, synonyms and plural forgiven).
+    pub fn find_region(&self, name: &str) -> Result<&Region, QueryError> {
+        self.find_region_with(&LexicalMatcher, name)
+    }
+
+    /// [`IvlMap::find_region`] with a chosen [`NameMatcher`].
+    pub fn find_region_with(
+        &self,
+        matcher: &dyn NameMatcher,
+        name: &str,
+    ) -> Result<&Region, QueryError> {
+        let names: Vec<&str> = self.regions.iter().map(|r| r.name.as_str()).collect();
+        let best = matcher
+            .best(name, &names)
+            .ok_or_else(|| QueryError::UnknownRegion {
+                name: name.trim().to_string(),
+                known: names.iter().map(|s| s.to_string()).collect(),
+            })?;
+        self.regions
+            .iter()
+            .find(|r| r.name == best)
+            .ok_or_else(|| QueryError::UnknownRegion {
+                name: name.to_string(),
+                known: vec![],
+            })
+    }
+
+    /// The region containing the point, if any.
+    pub fn region_at(&self, p: crate::geometry::Point) -> Option<&Region> {
+        self.regions.iter().find(|r| r.polygon.contains(p))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    /// Robot at the origin facing north. Tables at x = 1..4 along y = 3, the
+    /// yellow ones at x = 1 and 3.
+    fn map() -> IvlMap {
+        let s = Scene::from_json_str(
+            r#"{"format": "ivlmap-scene/1", "name": "q", "bounds": [-1, -1, 6, 6], "cell_size": 0.05,
+            "regions": [{"name": "living room", "polygon": [[-1,-1],[6,-1],[6,6],[-1,6]]}],
+            "objects": [
+              {"id": 1, "category": "table", "colour": "yellow", "center": [1.0, 3.0], "size": [0.5, 0.5]},
+              {"id": 2, "category": "table", "colour": "black", "center": [2.0, 3.0], "size": [0.5, 0.5]},
+              {"id": 3, "category": "table", "colour": "yellow", "center": [3.0, 3.0], "size": [0.5, 0.5]},
+              {"id": 4, "category": "table", "colour": null, "center": [4.0, 4.5], "size": [0.5, 0.5]},
+              {"id": 5, "category": "sofa", "colour": "grey", "center": [0.5, 5.0], "size": [1.5, 0.6]}
+            ],
+            "robot": {"pose": [0, 0, 0], "radius": 0.2}}"#,
+            "q.scene.json",
+        )
+        .unwrap();
+        IvlMap::from_scene(&s)
+    }
+
+    fn id(r: Result<&Instance, QueryError>) -> u32 {
+        r.unwrap().id
+    }
+
+    const AT_ORIGIN: Pose = Pose {
+        position: crate::geometry::Point::new(0.0, 0.0),
+        heading: 0.0,
+    };
+
+    #[test]
+    fn nearest_kth_last_and_colour() {
+        let m = map();
+        assert_eq!(
+            id(m.get_obj_attributes("table", 0, None, ObjectOrder::NearToFar, AT_ORIGIN)),
+            1
+        );
+        assert_eq!(
+            id(m.get_obj_attributes("tables", 2, None, ObjectOrder::NearToFar, AT_ORIGIN)),
+            2
+        );
+        assert_eq!(
+            id(m.get_obj_attributes("table", -1, None, ObjectOrder::NearToFar, AT_ORIGIN)),
+            4
+        );
+        assert_eq!(
+            id(m.get_obj_attributes(
+                "table",
+                2,
+                Some("Yellow"),
+                ObjectOrder::NearToFar,
+                AT_ORIGIN
+            )),
+            3
+        );
+        assert_eq!(
+            id(m.get_obj_attributes("couch", 0, Some("gray"), ObjectOrder::NearToFar, AT_ORIGIN)),
+            5
+        );
+        assert_eq!(
+            id(m.get_obj_attributes("table", 1, Some(""), ObjectOrder::FarToNear, AT_ORIGIN)),
+            4
+        );
+    }
+
+    #[test]
+    fn orders_follow_the_robot_frame_and_the_compass() {
+        let m = map();
+        let q = |k, o| id(m.get_obj_attributes("table", k, None, o, AT_ORIGIN));
+        assert_eq!(q(1, ObjectOrder::LeftToRight), 1);
+        assert_eq!(q(1, ObjectOrder::RightToLeft), 4);
+        assert_eq!(q(1, ObjectOrder::NorthToSouth), 4);
+        assert_eq!(q(-1, ObjectOrder::NorthToSouth), 3);
+        assert_eq!(q(2, ObjectOrder::WestToEast), 2);
+        assert_eq!(q(1, ObjectOrder::EastToWest), 4);
+        assert_eq!(q(1, ObjectOrder::SouthToNorth), 1);
+        // Facing south, left and right swap.
+        let south = Pose::new(0.0, 0.0, 180.0);
+        assert_eq!(
+            id(m.get_obj_attributes("table", 1, None, ObjectOrder::LeftToRight, south)),
+            4
+        );
+    }
+
+    #[test]
+    fn errors_say_what_the_map_holds() {
+        let m = map();
+        let e = m
+            .get_obj_attributes(
+                "table",
+                3,
+                Some("yellow"),
+                ObjectOrder::NearToFar,
+                AT_ORIGIN,
+            )
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "there are 2 yellow tables; asked for the 3rd"
+        );
+        let e = m
+            .get_obj_attributes("piano", 0, None, ObjectOrder::NearToFar, AT_ORIGIN)
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "the map has no \"piano\"; it holds 1 sofa, 4 tables"
+        );
+        let e = m
+            .get_obj_attributes(
+                "table",
+                0,
+                Some("purple"),
+                ObjectOrder::NearToFar,
+                AT_ORIGIN,
+            )
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "there is no purple table; the tables here are: 1 black, 2 yellow, 1 of unknown colour"
+        );
+        let e = m
+            .get_obj_attributes("table", 0, Some("left"), ObjectOrder::NearToFar, AT_ORIGIN)
+            .unwrap_err();
+        assert!(matches!(e, QueryError::NotAColour { .. }), "{e}");
+        let e = m
+            .get_obj_attributes("sofa", 2, None, ObjectOrder::NearToFar, AT_ORIGIN)
+            .unwrap_err();
+        assert_eq!(e.to_string(), "there is 1 sofa; asked for the 2nd");
+        assert!(matches!(
+            m.get_obj_attributes("sofa", -3, None, ObjectOrder::NearToFar, AT_ORIGIN),
+            Err(QueryError::BadOrdinal { k: -3 })
+        ));
+    }
+
+    #[test]
+    fn orders_parse_forgivingly() {
+        assert_eq!(
+            ObjectOrder::parse("Left to right").unwrap(),
+            ObjectOrder::LeftToRight
+        );
+        assert_eq!(ObjectOrder::parse("").unwrap(), ObjectOrder::NearToFar);
+        assert!(ObjectOrder::parse("up_to_down").is_err());
+        for (o, n) in ObjectOrder::ALL {
+            assert_eq!(ObjectOrder::parse(n).unwrap(), o);
+        }
+    }
+
+    #[test]
+    fn regions_by_name() {
+        let m = map();
+        assert_eq!(m.find_region("the Lounge").unwrap().name, "living room");
+        let e = m.find_region("garage").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "the map has no region \"garage\"; regions here are living room"
+        );
+    }
+
+    #[test]
+    fn ordinal_words() {
+        assert_eq!(ordinal_word(1), "1st");
+        assert_eq!(ordinal_word(12), "12th");
+        assert_eq!(ordinal_word(22), "22nd");
+        assert_eq!(ordinal_word(-1), "last");
+    }
+}
