@@ -18,6 +18,7 @@
 //! ```
 
 mod geometry;
+mod goals;
 mod grid;
 mod map;
 mod matcher;
@@ -26,6 +27,10 @@ mod scene;
 
 pub use crate::geometry::{
     closest_on_segment, normalize_heading, oriented_rect, Aabb, Point, Polygon, Pose,
+};
+pub use crate::goals::{
+    approach_point, between_point, closest_points, face_heading, heading_with_object_on,
+    lateral_point, region_point, side_point, Side, SIDE_CLEARANCE_M,
 };
 pub use crate::grid::{Cell, Grid, GridFrame};
 pub use crate::map::{Instance, IvlMap, Region};
