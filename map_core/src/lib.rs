@@ -22,6 +22,7 @@ mod goals;
 mod grid;
 mod map;
 mod matcher;
+mod persist;
 mod query;
 mod scene;
 
@@ -38,5 +39,6 @@ pub use crate::matcher::{
     canonical, is_colour_word, normalize, plural, singular, LexicalMatcher, NameMatcher,
     COLOUR_WORDS,
 };
+pub use crate::persist::{JsonLocation, PersistError, MAP_FORMAT};
 pub use crate::query::{ordinal_word, ObjectOrder, QueryError};
 pub use crate::scene::{Scene, SceneError, SceneLocation, SceneObject, SCENE_FORMAT};
