@@ -1,1 +1,27 @@
 //! # agent: the ivlmap language layer (work in progress)
+//!
+//! LLM backends: [`LlmBackend`] with [`LlamaCppBackend`] (local GGUF via llama.cpp),
+//! [`OpenAiBackend`] (any OpenAI-compatible server) and [`ReplayBackend`] / [`Recording`]
+//! (cassettes).
+
+mod backend;
+mod eval;
+mod language;
+
+pub use backend::{
+    render_chat_template, CassetteRecord, ChatMessage, Completion, CompletionRequest, FinishReason,
+    LlamaCppBackend, LlamaCppConfig, LlmBackend, LlmError, OpenAiBackend, OpenAiConfig, Recording,
+    ReplayBackend, Role, FALLBACK_CHAT_TEMPLATE,
+};
+pub use language::{
+    check_script, extract_code, extract_tuples, library_calls, normalise_colour, normalise_object,
+    parse_ordinal, parse_tuples, plan_instruction, pythonic_fixups, same_tuples, scene_summary,
+    simple_goto_script, tuples_paper_form, Arg, Finding, FindingKind, LanguageError, LibCall,
+    Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction, Pos, PromptError, Prompts,
+    Session, Timing, Tuple, TupleParseError, Turn, TEMPLATE_NAMES,
+};
+pub use eval::{
+    load_extract_suite, load_nav_suite, nav_scores, percentile, reached, run_extract, run_nav,
+    run_task, satisfies, summarise, summary_table, vlmap_script, CaseResult, ExtractCase, Method,
+    NavScores, NavTask, Report, Subgoal, SuiteError, SuiteKind, Summary, SUCCESS_RADIUS_M,
+};

@@ -1,0 +1,611 @@
+//! The local backend: a GGUF model run in-process by llama.cpp (llama-cpp-2).
+//!
+//! One worker thread owns the model and its context (`LlamaContext` is not `Sync` and
+//! borrows the model); callers talk to it through a channel and wait for the reply, so
+//! [`LlamaCppBackend`] is `Send + Sync` and requests are served one at a time.
+//!
+//! Prefix caching: the worker remembers which tokens sit in the KV cache. Each request's
+//! prompt is tokenized in full, the longest common prefix with the cached tokens is kept,
+//! the rest of the cache is dropped, and only the new tokens are evaluated. Prompts that
+//! share a long few-shot prefix therefore pay for it once.
+//!
+//! Chat template: the model's own (from its GGUF metadata), rendered by llama.cpp's
+//! `llama_chat_apply_template`, which recognises the common template families (ChatML,
+//! Llama-2/3, Mistral, Gemma, Phi, ...). A model without a template gets ChatML
+//! (`<|im_start|>role\ncontent<|im_end|>\n` per message, then `<|im_start|>assistant\n`).
+//! [`LlamaCppConfig::chat_template`] overrides both (a llama.cpp template name such as
+//! `"chatml"`, `"llama2"`, `"llama3"`, or a Jinja template string llama.cpp can identify).
+
+use std::num::NonZeroU32;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{self, Receiver, Sender, SyncSender};
+use std::sync::OnceLock;
+use std::thread::JoinHandle;
+use std::time::Instant;
+
+use llama_cpp_2::context::params::LlamaContextParams;
+use llama_cpp_2::context::LlamaContext;
+use llama_cpp_2::llama_backend::LlamaBackend as LlamaRuntime;
+use llama_cpp_2::llama_batch::LlamaBatch;
+use llama_cpp_2::model::params::LlamaModelParams;
+use llama_cpp_2::model::{LlamaChatMessage, LlamaChatTemplate, LlamaModel};
+use llama_cpp_2::sampling::LlamaSampler;
+use llama_cpp_2::token::LlamaToken;
+use llama_cpp_2::{ChatTemplateError, LogOptions};
+
+use super::{ChatMessage, Completion, CompletionRequest, FinishReason, LlmBackend, LlmError};
+
+/// The template used when a model carries none (llama.cpp's built-in ChatML).
+pub const FALLBACK_CHAT_TEMPLATE: &str = "chatml";
+
+/// Settings of the local llama.cpp backend.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LlamaCppConfig {
+    /// The GGUF file.
+    pub model_path: PathBuf,
+    /// CPU threads for generation and prompt processing (default 2).
+    pub threads: u32,
+    /// Context window in tokens: prompt plus answer (default 4096).
+    pub n_ctx: u32,
+    /// Tokens evaluated per llama.cpp batch while reading the prompt (default 512).
+    pub n_batch: u32,
+    /// Top-k for temperature sampling (ignored when greedy; default 40).
+    pub top_k: i32,
+    /// Top-p for temperature sampling (ignored when greedy; default 0.95).
+    pub top_p: f32,
+    /// Seed for temperature sampling (default 42).
+    pub seed: u32,
+    /// Overrides the model's chat template: a llama.cpp template name ("chatml", "llama2",
+    /// "llama3", ...) or a template string. `None`: the model's own, else ChatML.
+    pub chat_template: Option<String>,
+    /// Reuse the KV cache for a prompt prefix shared with the previous request (default on).
+    pub prefix_cache: bool,
+}
+
+impl LlamaCppConfig {
+    /// Defaults for `model_path`: 2 threads, 4096-token context, batch 512, prefix cache on.
+    pub fn new(model_path: impl Into<PathBuf>) -> Self {
+        Self {
+            model_path: model_path.into(),
+            threads: 2,
+            n_ctx: 4096,
+            n_batch: 512,
+            top_k: 40,
+            top_p: 0.95,
+            seed: 42,
+            chat_template: None,
+            prefix_cache: true,
+        }
+    }
+}
+
+/// llama.cpp's process-wide initialisation (allowed once per process), with its logs routed
+/// into `tracing`.
+fn runtime() -> Result<&'static LlamaRuntime, LlmError> {
+    static RUNTIME: OnceLock<Result<LlamaRuntime, String>> = OnceLock::new();
+    RUNTIME
+        .get_or_init(|| {
+            llama_cpp_2::send_logs_to_tracing(LogOptions::default());
+            LlamaRuntime::init().map_err(|e| e.to_string())
+        })
+        .as_ref()
+        .map_err(|e| LlmError::ModelLoad {
+            path: PathBuf::new(),
+            reason: format!("llama.cpp backend initialisation failed: {e}"),
+        })
+}
+
+fn load_model(path: &Path, vocab_only: bool) -> Result<LlamaModel, LlmError> {
+    let fail = |reason: String| LlmError::ModelLoad {
+        path: path.to_path_buf(),
+        reason,
+    };
+    // llama-cpp-2 debug-asserts that the file exists: check first, with a clear message.
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => {}
+        Ok(_) => return Err(fail("not a file".into())),
+        Err(e) => {
+            return Err(fail(format!(
+                "{e} (fetch models with scripts/fetch-models.sh)"
+            )))
+        }
+    }
+    let rt = runtime()?;
+    let params = LlamaModelParams::default().with_vocab_only(vocab_only);
+    LlamaModel::load_from_file(rt, path, &params).map_err(|e| {
+        fail(format!(
+            "llama.cpp could not load it ({e}): not a GGUF file, a truncated download, or an \
+             architecture this llama.cpp does not know; its log (tracing target llama.cpp) says which"
+        ))
+    })
+}
+
+fn resolve_template(
+    model: &LlamaModel,
+    override_: Option<&str>,
+) -> Result<LlamaChatTemplate, LlmError> {
+    let bad = |e: std::ffi::NulError| LlmError::ChatTemplate {
+        message: format!("template contains a NUL byte: {e}"),
+    };
+    if let Some(t) = override_ {
+        return LlamaChatTemplate::new(t).map_err(bad);
+    }
+    match model.chat_template(None) {
+        Ok(t) => Ok(t),
+        Err(ChatTemplateError::MissingTemplate) => {
+            tracing::info!("model has no chat template; using ChatML");
+            LlamaChatTemplate::new(FALLBACK_CHAT_TEMPLATE).map_err(bad)
+        }
+        Err(e) => Err(LlmError::ChatTemplate {
+            message: format!("cannot read the model's chat template: {e}"),
+        }),
+    }
+}
+
+fn render(
+    model: &LlamaModel,
+    template: &LlamaChatTemplate,
+    messages: &[ChatMessage],
+) -> Result<String, LlmError> {
+    let chat = messages
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            LlamaChatMessage::new(m.role.as_str().to_string(), m.content.clone()).map_err(|e| {
+                LlmError::InvalidRequest {
+                    message: format!("message {i} contains a NUL byte: {e}"),
+                }
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    model
+        .apply_chat_template(template, &chat, true)
+        .map_err(|e| LlmError::ChatTemplate {
+            message: format!(
+                "llama.cpp cannot apply this chat template ({e}); it only knows the common \
+                 families: set chat_template to one of its names, e.g. \"chatml\" or \"llama2\""
+            ),
+        })
+}
+
+/// Renders `messages` with `template` (a llama.cpp template name or template string) using
+/// the tokenizer of the GGUF at `gguf` (loaded vocabulary-only: no weights are read), the
+/// way [`LlamaCppBackend`] would render its prompt, including the assistant turn's opening.
+///
+/// # Errors
+/// [`LlmError::ModelLoad`], [`LlmError::ChatTemplate`], [`LlmError::InvalidRequest`].
+pub fn render_chat_template(
+    gguf: &Path,
+    template: &str,
+    messages: &[ChatMessage],
+) -> Result<String, LlmError> {
+    let model = load_model(gguf, true)?;
+    let template = resolve_template(&model, Some(template))?;
+    render(&model, &template, messages)
+}
+
+enum Job {
+    Complete {
+        req: CompletionRequest,
+        reply: SyncSender<Result<Completion, LlmError>>,
+    },
+    Render {
+        messages: Vec<ChatMessage>,
+        reply: SyncSender<Result<String, LlmError>>,
+    },
+}
+
+/// A local GGUF model served by llama.cpp on a dedicated worker thread.
+#[derive(Debug)]
+pub struct LlamaCppBackend {
+    model_name: String,
+    config: LlamaCppConfig,
+    tx: Option<Sender<Job>>,
+    worker: Option<JoinHandle<()>>,
+}
+
+impl LlamaCppBackend {
+    /// Loads the model and creates its context on a new worker thread; returns once both are
+    /// ready.
+    ///
+    /// # Errors
+    /// [`LlmError::ModelLoad`] (missing or unreadable file, context allocation failure),
+    /// [`LlmError::ChatTemplate`], [`LlmError::Config`] (zero threads/context/batch).
+    pub fn new(config: LlamaCppConfig) -> Result<Self, LlmError> {
+        if config.threads == 0 || config.n_ctx == 0 || config.n_batch == 0 {
+            return Err(LlmError::Config {
+                message: format!(
+                    "threads ({}), n_ctx ({}) and n_batch ({}) must all be at least 1",
+                    config.threads, config.n_ctx, config.n_batch
+                ),
+            });
+        }
+        let model_name = config
+            .model_path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| config.model_path.display().to_string());
+        let (tx, rx) = mpsc::channel::<Job>();
+        let (ready_tx, ready_rx) = mpsc::sync_channel::<Result<(), LlmError>>(1);
+        let worker_cfg = config.clone();
+        let worker = std::thread::Builder::new()
+            .name("llama-worker".into())
+            .spawn(move || worker_main(worker_cfg, ready_tx, rx))
+            .map_err(|e| LlmError::Worker {
+                message: format!("cannot spawn the worker thread: {e}"),
+            })?;
+        match ready_rx.recv() {
+            Ok(Ok(())) => Ok(Self {
+                model_name,
+                config,
+                tx: Some(tx),
+                worker: Some(worker),
+            }),
+            Ok(Err(e)) => {
+                let _ = worker.join();
+                Err(e)
+            }
+            Err(_) => {
+                let _ = worker.join();
+                Err(LlmError::Worker {
+                    message: "the worker thread ended while loading the model".into(),
+                })
+            }
+        }
+    }
+
+    /// The configuration it was built with.
+    #[must_use]
+    pub fn config(&self) -> &LlamaCppConfig {
+        &self.config
+    }
+
+    /// The prompt text this backend would feed the model for `messages` (chat template
+    /// applied, assistant turn opened).
+    ///
+    /// # Errors
+    /// [`LlmError::ChatTemplate`], [`LlmError::InvalidRequest`], [`LlmError::Worker`].
+    pub fn render_prompt(&self, messages: &[ChatMessage]) -> Result<String, LlmError> {
+        let (reply, rx) = mpsc::sync_channel(1);
+        self.send(Job::Render {
+            messages: messages.to_vec(),
+            reply,
+        })?;
+        rx.recv().map_err(|_| worker_gone())?
+    }
+
+    fn send(&self, job: Job) -> Result<(), LlmError> {
+        self.tx
+            .as_ref()
+            .ok_or_else(worker_gone)?
+            .send(job)
+            .map_err(|_| worker_gone())
+    }
+}
+
+fn worker_gone() -> LlmError {
+    LlmError::Worker {
+        message: "the llama.cpp worker thread has stopped (see earlier errors or a panic \
+                  message); create a new backend"
+            .into(),
+    }
+}
+
+impl LlmBackend for LlamaCppBackend {
+    fn name(&self) -> &str {
+        "llama"
+    }
+
+    fn model(&self) -> &str {
+        &self.model_name
+    }
+
+    fn complete(&self, req: &CompletionRequest) -> Result<Completion, LlmError> {
+        req.validate()?;
+        let (reply, rx) = mpsc::sync_channel(1);
+        self.send(Job::Complete {
+            req: req.clone(),
+            reply,
+        })?;
+        rx.recv().map_err(|_| worker_gone())?
+    }
+}
+
+impl Drop for LlamaCppBackend {
+    fn drop(&mut self) {
+        drop(self.tx.take());
+        if let Some(w) = self.worker.take() {
+            let _ = w.join();
+        }
+    }
+}
+
+fn worker_main(cfg: LlamaCppConfig, ready: SyncSender<Result<(), LlmError>>, rx: Receiver<Job>) {
+    let setup = || -> Result<(LlamaModel, LlamaChatTemplate), LlmError> {
+        let model = load_model(&cfg.model_path, false)?;
+        let template = resolve_template(&model, cfg.chat_template.as_deref())?;
+        Ok((model, template))
+    };
+    let (model, template) = match setup() {
+        Ok(x) => x,
+        Err(e) => {
+            let _ = ready.send(Err(e));
+            return;
+        }
+    };
+    let rt = match runtime() {
+        Ok(rt) => rt,
+        Err(e) => {
+            let _ = ready.send(Err(e));
+            return;
+        }
+    };
+    let threads = i32::try_from(cfg.threads).unwrap_or(i32::MAX);
+    let params = LlamaContextParams::default()
+        .with_n_ctx(NonZeroU32::new(cfg.n_ctx))
+        .with_n_batch(cfg.n_batch)
+        .with_n_ubatch(cfg.n_batch)
+        .with_n_threads(threads)
+        .with_n_threads_batch(threads);
+    let ctx = match model.new_context(rt, params) {
+        Ok(ctx) => ctx,
+        Err(e) => {
+            let _ = ready.send(Err(LlmError::ModelLoad {
+                path: cfg.model_path.clone(),
+                reason: format!(
+                    "cannot create a {}-token context ({e}); try a smaller n_ctx",
+                    cfg.n_ctx
+                ),
+            }));
+            return;
+        }
+    };
+    let mut worker = Worker {
+        model: &model,
+        ctx,
+        template,
+        cached: Vec::new(),
+        cfg: &cfg,
+    };
+    if ready.send(Ok(())).is_err() {
+        return;
+    }
+    for job in rx {
+        match job {
+            Job::Complete { req, reply } => {
+                let _ = reply.send(worker.complete(&req));
+            }
+            Job::Render { messages, reply } => {
+                let _ = reply.send(render(worker.model, &worker.template, &messages));
+            }
+        }
+    }
+}
+
+struct Worker<'m> {
+    model: &'m LlamaModel,
+    ctx: LlamaContext<'m>,
+    template: LlamaChatTemplate,
+    /// The tokens whose keys/values are in the KV cache (sequence 0), in position order.
+    cached: Vec<LlamaToken>,
+    cfg: &'m LlamaCppConfig,
+}
+
+impl Worker<'_> {
+    fn sampler(&self, req: &CompletionRequest) -> Result<LlamaSampler, LlmError> {
+        let grammar = match (&req.grammar, &req.json_schema) {
+            (Some(g), _) => Some(g.clone()),
+            (None, Some(schema)) => Some(
+                llama_cpp_2::json_schema_to_grammar(&schema.to_string()).map_err(|e| {
+                    LlmError::Grammar {
+                        message: format!("cannot convert json_schema to a grammar: {e}"),
+                    }
+                })?,
+            ),
+            (None, None) => None,
+        };
+        let mut chain = Vec::new();
+        if let Some(g) = grammar {
+            let s =
+                LlamaSampler::grammar(self.model, &g, "root").map_err(|e| LlmError::Grammar {
+                    message: format!(
+                        "llama.cpp rejected the GBNF grammar ({e}); it needs a `root` rule and \
+                     valid GBNF (the parse error is in the tracing log, target llama.cpp)"
+                    ),
+                })?;
+            chain.push(s);
+        }
+        if req.temperature <= 0.0 {
+            chain.push(LlamaSampler::greedy());
+        } else {
+            chain.push(LlamaSampler::top_k(self.cfg.top_k));
+            chain.push(LlamaSampler::top_p(self.cfg.top_p, 1));
+            chain.push(LlamaSampler::temp(req.temperature));
+            chain.push(LlamaSampler::dist(self.cfg.seed));
+        }
+        Ok(LlamaSampler::chain_simple(chain))
+    }
+
+    fn reset_cache(&mut self) {
+        self.ctx.clear_kv_cache();
+        self.cached.clear();
+    }
+
+    fn decode(&mut self, batch: &mut LlamaBatch<'_>) -> Result<(), LlmError> {
+        self.ctx.decode(batch).map_err(|e| {
+            self.reset_cache();
+            LlmError::Decode {
+                message: e.to_string(),
+            }
+        })
+    }
+
+    fn complete(&mut self, req: &CompletionRequest) -> Result<Completion, LlmError> {
+        let model: &LlamaModel = self.model;
+        let prompt = render(model, &self.template, &req.messages)?;
+        let vocab = model.vocab();
+        let mut tokens = vocab.tokenize(prompt.as_bytes(), true, true);
+        // Templates that spell out BOS plus a tokenizer that adds one would double it.
+        if tokens.len() >= 2 && tokens[0] == vocab.bos() && tokens[1] == vocab.bos() {
+            tokens.remove(0);
+        }
+        let n_ctx = self.ctx.n_ctx() as usize;
+        if tokens.is_empty() {
+            return Err(LlmError::InvalidRequest {
+                message: "the rendered prompt has no tokens".into(),
+            });
+        }
+        if tokens.len() >= n_ctx {
+            return Err(LlmError::ContextOverflow {
+                prompt_tokens: tokens.len(),
+                n_ctx: self.ctx.n_ctx(),
+            });
+        }
+        // Build the sampler first: a bad grammar fails before the cache is touched.
+        let mut sampler = self.sampler(req)?;
+
+        // Keep the longest common prefix of the cache; always evaluate at least one token so
+        // that there are fresh logits to sample from.
+        let mut keep = if self.cfg.prefix_cache {
+            self.cached
+                .iter()
+                .zip(&tokens)
+                .take_while(|(a, b)| a == b)
+                .count()
+        } else {
+            0
+        };
+        keep = keep.min(tokens.len() - 1);
+        if keep < self.cached.len() {
+            let removed = u32::try_from(keep)
+                .ok()
+                .and_then(|p0| self.ctx.clear_kv_cache_seq(Some(0), Some(p0), None).ok());
+            if removed != Some(true) {
+                // Some memory types (recurrent models) cannot drop a suffix: start over.
+                self.reset_cache();
+                keep = 0;
+            }
+            self.cached.truncate(keep);
+        }
+
+        let t_prompt = Instant::now();
+        let n_batch = (self.ctx.n_batch() as usize).max(1);
+        let mut batch = LlamaBatch::new(n_batch, 1);
+        let mut last_idx = 0;
+        for (ci, chunk) in tokens[keep..].chunks(n_batch).enumerate() {
+            batch.clear();
+            let base = keep + ci * n_batch;
+            for (j, &tok) in chunk.iter().enumerate() {
+                let pos = base + j;
+                add(&mut batch, tok, pos, pos + 1 == tokens.len())?;
+            }
+            self.decode(&mut batch)?;
+            self.cached.extend_from_slice(chunk);
+            last_idx = batch.n_tokens() - 1;
+        }
+        let prompt_ms = t_prompt.elapsed().as_secs_f64() * 1e3;
+
+        let t_gen = Instant::now();
+        let max_new = (req.max_tokens as usize).min(n_ctx - tokens.len());
+        let max_stop = req.stop.iter().map(String::len).max().unwrap_or(0);
+        let mut out: Vec<u8> = Vec::new();
+        let mut n_gen = 0usize;
+        let mut pos = tokens.len();
+        let finish = loop {
+            if n_gen >= max_new {
+                break FinishReason::Length;
+            }
+            // `sample` also accepts the token into every sampler of the chain (grammar
+            // included); accepting it again would corrupt the grammar state.
+            let tok = sampler.sample(&self.ctx, last_idx);
+            if vocab.is_eog(tok) {
+                break FinishReason::Stop;
+            }
+            n_gen += 1;
+            let before = out.len();
+            out.extend_from_slice(&vocab.token_to_piece(tok, false, None));
+            if let Some(cut) = find_stop(&out, before, max_stop, &req.stop) {
+                out.truncate(cut);
+                break FinishReason::Stop;
+            }
+            if n_gen >= max_new {
+                break FinishReason::Length;
+            }
+            batch.clear();
+            add(&mut batch, tok, pos, true)?;
+            self.decode(&mut batch)?;
+            self.cached.push(tok);
+            pos += 1;
+            last_idx = 0;
+        };
+        let generate_ms = t_gen.elapsed().as_secs_f64() * 1e3;
+        Ok(Completion {
+            text: String::from_utf8_lossy(&out).into_owned(),
+            prompt_tokens: count(tokens.len()),
+            cached_prompt_tokens: count(keep),
+            completion_tokens: count(n_gen),
+            prompt_ms,
+            generate_ms,
+            finish_reason: finish,
+        })
+    }
+}
+
+fn count(n: usize) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}
+
+fn add(
+    batch: &mut LlamaBatch<'_>,
+    tok: LlamaToken,
+    pos: usize,
+    logits: bool,
+) -> Result<(), LlmError> {
+    let pos = i32::try_from(pos).map_err(|_| LlmError::Decode {
+        message: format!("position {pos} does not fit llama.cpp's i32"),
+    })?;
+    batch
+        .add(tok, pos, &[0], logits)
+        .map_err(|e| LlmError::Decode {
+            message: format!("cannot add a token to the batch: {e}"),
+        })
+}
+
+/// The byte offset where the earliest stop string starts, looking only at matches that end
+/// in the bytes appended since `before`.
+fn find_stop(out: &[u8], before: usize, max_stop: usize, stops: &[String]) -> Option<usize> {
+    let from = before.saturating_sub(max_stop.saturating_sub(1));
+    stops
+        .iter()
+        .filter_map(|s| {
+            let s = s.as_bytes();
+            out[from..]
+                .windows(s.len())
+                .position(|w| w == s)
+                .map(|p| from + p)
+        })
+        .min()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn find_stop_sees_strings_spanning_pieces() {
+        let stops = vec!["```".to_string(), "END".to_string()];
+        let out = b"let x = 1;\n``";
+        assert_eq!(find_stop(out, 10, 3, &stops), None);
+        let out = b"let x = 1;\n```\n";
+        assert_eq!(find_stop(out, 13, 3, &stops), Some(11));
+        assert_eq!(find_stop(b"xEND", 1, 3, &stops), Some(1));
+    }
+
+    #[test]
+    fn zero_sizes_are_config_errors() {
+        let mut cfg = LlamaCppConfig::new("/nonexistent.gguf");
+        cfg.threads = 0;
+        let err = LlamaCppBackend::new(cfg).unwrap_err();
+        assert!(matches!(err, LlmError::Config { .. }), "{err}");
+    }
+}
