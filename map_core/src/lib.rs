@@ -23,6 +23,8 @@ mod grid;
 mod map;
 mod matcher;
 mod persist;
+mod npy;
+mod planner;
 mod query;
 mod scene;
 
@@ -38,6 +40,11 @@ pub use crate::map::{Instance, IvlMap, Region};
 pub use crate::matcher::{
     canonical, is_colour_word, normalize, plural, singular, LexicalMatcher, NameMatcher,
     COLOUR_WORDS,
+};
+pub use crate::npy::{read_npy, read_npy_from, write_npy, write_npy_to, NpyElement, NpyError};
+pub use crate::planner::{
+    astar, inflate, inflate_m, line_of_sight, octile, polyline_len, supercover_cells, GridPath,
+    GridPlanner, Passability, PlanError, WorldPath,
 };
 pub use crate::persist::{JsonLocation, PersistError, MAP_FORMAT};
 pub use crate::query::{ordinal_word, ObjectOrder, QueryError};
