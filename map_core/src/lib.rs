@@ -26,6 +26,7 @@ mod persist;
 mod npy;
 mod planner;
 mod query;
+mod render;
 mod scene;
 
 pub use crate::geometry::{
@@ -48,4 +49,8 @@ pub use crate::planner::{
 };
 pub use crate::persist::{JsonLocation, PersistError, MAP_FORMAT};
 pub use crate::query::{ordinal_word, ObjectOrder, QueryError};
+pub use crate::render::{
+    auto_scale, colour_rgb, render_png, render_rgb, RenderError, RenderOptions, RenderOverlay,
+    FINAL_RGB, MAX_SIDE_PX, PALETTE, PATH_RGB, START_RGB, STOP_RGB, UNKNOWN_RGB, WALL_RGB,
+};
 pub use crate::scene::{Scene, SceneError, SceneLocation, SceneObject, SCENE_FORMAT};

@@ -5,6 +5,9 @@
 //! has the variety the navigation suites rely on (several instances of a category in
 //! different colours, a row of 3+ same-category objects, rotated objects).
 
+// Test helpers outside #[test] functions may unwrap and panic too.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use std::collections::{HashMap, VecDeque};
 use std::path::PathBuf;
 

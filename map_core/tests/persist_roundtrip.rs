@@ -1,6 +1,9 @@
 //! Saving a map folder and loading it back, its errors, and that NumPy reads the
 //! layers with the documented dtypes and shapes.
 
+// Test helpers outside #[test] functions may unwrap and panic too.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
