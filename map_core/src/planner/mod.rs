@@ -4,8 +4,8 @@
 //!
 //! Obstacle grids are `Grid<bool>` with `true` = occupied. The search works on any
 //! map that implements [`Passability`]; [`GridPlanner`] copies such a map once into a
-//! padded byte grid and labels its connected free areas, so that each query knows
-//! at once whether the goal is reachable and never scans a whole map in vain.
+//! padded byte grid; its connected free areas are labelled on first need (goal
+//! snapping), after which unreachable goals are refused without a search.
 //!
 //! ```
 //! use map_core::{Cell, Grid, GridPlanner, inflate};
@@ -25,7 +25,7 @@ mod line_of_sight;
 mod nearest;
 mod smooth;
 
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 use crate::geometry::Point;
 use crate::grid::{Cell, Grid, GridFrame};
@@ -222,7 +222,10 @@ impl Passability for Padded {
 #[derive(Debug)]
 pub struct GridPlanner {
     map: Padded,
-    labels: Vec<u32>,
+    /// Connected-area labels, computed on first need (goal snapping,
+    /// `nearest_reachable_free`, `connected`), so that a fresh planner answers its
+    /// first ordinary query without labelling the whole map.
+    labels: OnceLock<Vec<u32>>,
     scratch: Mutex<jps::Scratch>,
 }
 
@@ -238,13 +241,16 @@ impl GridPlanner {
     }
 
     fn from_padded(map: Padded) -> Self {
-        let labels = components::label(&map);
         let scratch = Mutex::new(jps::Scratch::new(map.free.len()));
         Self {
             map,
-            labels,
+            labels: OnceLock::new(),
             scratch,
         }
+    }
+
+    fn labels(&self) -> &[u32] {
+        self.labels.get_or_init(|| components::label(&self.map))
     }
 
     pub fn rows(&self) -> usize {
@@ -264,7 +270,7 @@ impl GridPlanner {
     pub fn connected(&self, a: Cell, b: Cell) -> bool {
         self.is_free(a)
             && self.is_free(b)
-            && self.labels[self.map.idx(a)] == self.labels[self.map.idx(b)]
+            && self.labels()[self.map.idx(a)] == self.labels()[self.map.idx(b)]
     }
 
     /// The free cell nearest to `cell` (Euclidean between centres; `cell` itself when free).
@@ -279,8 +285,9 @@ impl GridPlanner {
         if !self.is_free(from) {
             return None;
         }
-        let lab = self.labels[self.map.idx(from)];
-        nearest::nearest(&self.map, target, |i| self.labels[i] == lab)
+        let labels = self.labels();
+        let lab = labels[self.map.idx(from)];
+        nearest::nearest(&self.map, target, |i| labels[i] == lab)
     }
 
     /// Plan from `start` to `goal`. A start in an obstacle moves to the nearest free
@@ -315,13 +322,16 @@ impl GridPlanner {
             self.nearest_reachable_free(s, goal)
                 .ok_or(PlanError::NoFreeCell)?
         };
-        if !self.connected(s, g) {
-            return Err(PlanError::Unreachable {
-                start,
-                goal,
-                start_world,
-                goal_world,
-            });
+        // labels known (from an earlier snap): refuse at once instead of searching in vain
+        if let Some(labels) = self.labels.get() {
+            if labels[self.map.idx(s)] != labels[self.map.idx(g)] {
+                return Err(PlanError::Unreachable {
+                    start,
+                    goal,
+                    start_world,
+                    goal_world,
+                });
+            }
         }
         let mut local;
         let mut guard = self.scratch.try_lock();
