@@ -123,11 +123,25 @@ fn d2(a: Cell, b: Cell) -> usize {
 
 /// A cluttered grid: random cells and random rectangles, optionally inflated.
 fn grid_strategy() -> impl Strategy<Value = Grid<bool>> {
+    sized_grid(36)
+}
+
+/// Grids up to `max` cells a side: above 62 columns (rows) the bit-parallel row
+/// (column) scans of the jump point search cross 64-bit words.
+fn sized_grid(max: usize) -> impl Strategy<Value = Grid<bool>> {
     (
-        3usize..36,
-        3usize..36,
+        3usize..max,
+        3usize..max,
         0.0f64..0.35,
-        prop::collection::vec((0usize..36, 0usize..36, 1usize..8, 1usize..8), 0..6),
+        prop::collection::vec(
+            (
+                0usize..max,
+                0usize..max,
+                1usize..max / 4 + 2,
+                1usize..max / 4 + 2,
+            ),
+            0..8,
+        ),
         0u8..3,
         any::<u64>(),
     )
@@ -226,6 +240,29 @@ proptest! {
                 prop_assert!(g.get(t) == Some(&false) && reach.get(t) == Some(&false));
             }
             Err(e) => prop_assert!(false, "unexpected error {e}"),
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 120, ..ProptestConfig::default() })]
+
+    #[test]
+    fn large_grids_match_dijkstra(g in sized_grid(200), sr in 0usize..400, sc in 0usize..400, tr in 0usize..400, tc in 0usize..400) {
+        let (s, t) = (cell_in(&g, sr, sc), cell_in(&g, tr, tc));
+        prop_assume!(g.get(s) == Some(&false) && g.get(t) == Some(&false));
+        let planner = GridPlanner::new(g.clone());
+        match (planner.plan(s, t), dijkstra(&g, s, t)) {
+            (Ok(p), Some(opt)) => {
+                prop_assert!((p.raw_len - opt).abs() < 1e-9, "raw {} != Dijkstra {}", p.raw_len, opt);
+                for w in p.waypoints.windows(2) {
+                    for cell in touched_cells(&g, w[0], w[1]) {
+                        prop_assert!(g.get(cell) == Some(&false), "segment {:?} touches occupied {:?}", w, cell);
+                    }
+                }
+            }
+            (Err(PlanError::Unreachable { .. }), None) => {}
+            (got, opt) => prop_assert!(false, "planner {got:?} vs Dijkstra {opt:?}"),
         }
     }
 }

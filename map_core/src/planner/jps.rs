@@ -52,34 +52,137 @@ fn step(i: usize, d: isize) -> usize {
     i.wrapping_add_signed(d)
 }
 
-/// Straight jump from `i` along `d`; `p` is the perpendicular offset (w for a
-/// horizontal move, 1 for a vertical one).
-#[inline]
-fn jump_straight(free: &[bool], mut i: usize, d: isize, p: usize, goal: usize) -> Option<usize> {
-    loop {
-        let back = i;
-        i = step(i, d);
-        if !free[i] {
-            return None;
+/// Free cells as bits, one bit line per padded row (or per padded column for the
+/// transposed copy): straight jumps test 64 cells at a time.
+#[derive(Debug, Clone)]
+pub(crate) struct Lines {
+    wpl: usize,
+    bits: Vec<u64>,
+}
+
+impl Lines {
+    /// `n_lines` lines of `len` bits; bit k of line l is `f(l, k)`.
+    pub fn build(n_lines: usize, len: usize, f: impl Fn(usize, usize) -> bool) -> Self {
+        let wpl = len / 64 + 1;
+        let mut bits = vec![0u64; n_lines * wpl];
+        for l in 0..n_lines {
+            for k in 0..len {
+                if f(l, k) {
+                    bits[l * wpl + k / 64] |= 1 << (k % 64);
+                }
+            }
         }
-        if i == goal {
-            return Some(i);
+        Self { wpl, bits }
+    }
+
+    #[inline]
+    fn word(&self, l: usize, wi: usize) -> u64 {
+        if wi >= self.wpl {
+            return 0;
         }
-        if (free[i - p] && !free[back - p]) || (free[i + p] && !free[back + p]) {
-            return Some(i);
+        self.bits.get(l * self.wpl + wi).copied().unwrap_or(0)
+    }
+
+    /// First stop after `pos` moving up line `l`: a blocked cell (None) or a cell
+    /// where a neighbour line opens up behind a wall (Some), or `goal` if sooner.
+    #[inline]
+    fn scan_up(&self, l: usize, pos: usize, goal: Option<usize>) -> Option<usize> {
+        let mut wi = pos / 64;
+        let b0 = pos % 64;
+        let mut mask = if b0 == 63 { 0 } else { !0u64 << (b0 + 1) };
+        while wi < self.wpl {
+            let (b, u, d) = (self.word(l, wi), self.word(l - 1, wi), self.word(l + 1, wi));
+            let (pu, pd) = if wi == 0 {
+                (0, 0)
+            } else {
+                (
+                    self.word(l - 1, wi - 1) >> 63,
+                    self.word(l + 1, wi - 1) >> 63,
+                )
+            };
+            let stop = (!b | (u & !((u << 1) | pu)) | (d & !((d << 1) | pd))) & mask;
+            if stop != 0 {
+                let x = wi * 64 + stop.trailing_zeros() as usize;
+                if let Some(g) = goal {
+                    if g > pos && g <= x {
+                        return Some(g);
+                    }
+                }
+                return if (b >> (x % 64)) & 1 == 1 {
+                    Some(x)
+                } else {
+                    None
+                };
+            }
+            wi += 1;
+            mask = !0;
+        }
+        None
+    }
+
+    /// As [`Lines::scan_up`], moving down line `l` from `pos`.
+    #[inline]
+    fn scan_down(&self, l: usize, pos: usize, goal: Option<usize>) -> Option<usize> {
+        let mut wi = pos / 64;
+        let mut mask = (1u64 << (pos % 64)) - 1;
+        loop {
+            let (b, u, d) = (self.word(l, wi), self.word(l - 1, wi), self.word(l + 1, wi));
+            let (nu, nd) = (
+                self.word(l - 1, wi + 1) << 63,
+                self.word(l + 1, wi + 1) << 63,
+            );
+            let stop = (!b | (u & !((u >> 1) | nu)) | (d & !((d >> 1) | nd))) & mask;
+            if stop != 0 {
+                let x = wi * 64 + 63 - stop.leading_zeros() as usize;
+                if let Some(g) = goal {
+                    if g < pos && g >= x {
+                        return Some(g);
+                    }
+                }
+                return if (b >> (x % 64)) & 1 == 1 {
+                    Some(x)
+                } else {
+                    None
+                };
+            }
+            if wi == 0 {
+                return None;
+            }
+            wi -= 1;
+            mask = !0;
         }
     }
 }
 
+/// Straight jump from padded index `i` along (dr, dc), one of which is 0: the
+/// next blocked cell ends it (None); a cell beside which a side cell opens up
+/// behind a wall, or the goal, is a jump point.
 #[inline]
-fn jump_diag(
-    free: &[bool],
-    w: usize,
-    mut i: usize,
-    dr: isize,
-    dc: isize,
-    goal: usize,
-) -> Option<usize> {
+fn jump_straight(map: &Padded, i: usize, dr: isize, dc: isize, goal: usize) -> Option<usize> {
+    let w = map.w;
+    let (r, c) = (i / w, i % w);
+    if dr == 0 {
+        let g = (goal / w == r).then_some(goal % w);
+        let x = if dc > 0 {
+            map.row_bits.scan_up(r, c, g)
+        } else {
+            map.row_bits.scan_down(r, c, g)
+        }?;
+        Some(r * w + x)
+    } else {
+        let g = (goal % w == c).then_some(goal / w);
+        let x = if dr > 0 {
+            map.col_bits.scan_up(c, r, g)
+        } else {
+            map.col_bits.scan_down(c, r, g)
+        }?;
+        Some(x * w + c)
+    }
+}
+
+#[inline]
+fn jump_diag(map: &Padded, mut i: usize, dr: isize, dc: isize, goal: usize) -> Option<usize> {
+    let (free, w) = (&map.free[..], map.w);
     let vr = dr * w as isize;
     let d = vr + dc;
     loop {
@@ -88,8 +191,8 @@ fn jump_diag(
         }
         i = step(i, d);
         if i == goal
-            || jump_straight(free, i, dc, w, goal).is_some()
-            || jump_straight(free, i, vr, 1, goal).is_some()
+            || jump_straight(map, i, 0, dc, goal).is_some()
+            || jump_straight(map, i, dr, 0, goal).is_some()
         {
             return Some(i);
         }
@@ -205,11 +308,9 @@ pub(crate) fn search(
         let gi = s.g[i];
         for &(dr, dc) in &dirs[..nd] {
             let j = if dr != 0 && dc != 0 {
-                jump_diag(free, w, i, dr, dc, goal)
-            } else if dr == 0 {
-                jump_straight(free, i, dc, w, goal)
+                jump_diag(map, i, dr, dc, goal)
             } else {
-                jump_straight(free, i, dr * w as isize, 1, goal)
+                jump_straight(map, i, dr, dc, goal)
             };
             let Some(j) = j else { continue };
             if s.stamp[j] == closed {

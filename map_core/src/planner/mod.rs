@@ -150,6 +150,9 @@ pub(crate) struct Padded {
     pub cols: usize,
     pub w: usize,
     pub free: Vec<bool>,
+    /// `free` as bits by padded row and by padded column, for straight jumps.
+    pub row_bits: jps::Lines,
+    pub col_bits: jps::Lines,
 }
 
 impl Padded {
@@ -163,12 +166,7 @@ impl Padded {
                 free[base + c] = map.is_free(Cell::new(r, c));
             }
         }
-        Self {
-            rows,
-            cols,
-            w,
-            free,
-        }
+        Self::with_bits(rows, cols, w, free)
     }
 
     fn from_obstacles(g: &Grid<bool>) -> Self {
@@ -186,11 +184,20 @@ impl Padded {
                 *dst = !occ;
             }
         }
+        Self::with_bits(rows, cols, w, free)
+    }
+
+    fn with_bits(rows: usize, cols: usize, w: usize, free: Vec<bool>) -> Self {
+        let h = rows + 2;
+        let row_bits = jps::Lines::build(h, w, |r, c| free[r * w + c]);
+        let col_bits = jps::Lines::build(w, h, |c, r| free[r * w + c]);
         Self {
             rows,
             cols,
             w,
             free,
+            row_bits,
+            col_bits,
         }
     }
 
