@@ -1,0 +1,76 @@
+//! A compiled and validated plan.
+
+use crate::engine;
+use crate::error::{PlanError, Span};
+use crate::limits::Limits;
+use crate::registry::FORBIDDEN;
+use crate::validate::{validate, CallSite};
+use rhai::AST;
+
+/// A script that compiled and passed validation: it calls only the robot function
+/// library, `say`, the allowed builtins and functions it defines itself. Compile
+/// once, run many times.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    source: String,
+    ast: AST,
+    calls: Vec<CallSite>,
+}
+
+impl Plan {
+    /// Compiles and validates `source` under the default [`Limits`].
+    ///
+    /// ```
+    /// use planner_dsl::{Plan, PlanError};
+    /// let plan = Plan::compile("let t = agent.get_obj_attributes(\"table\", 3, \"yellow\");\nagent.face(t);")?;
+    /// assert_eq!(plan.library_calls().len(), 2);
+    /// let err = Plan::compile("agent.fly(1);\nsleep(5);").unwrap_err();
+    /// assert_eq!(err.spans().len(), 2); // every violation, each with line and column
+    /// # Ok::<(), PlanError>(())
+    /// ```
+    pub fn compile(source: &str) -> Result<Plan, PlanError> {
+        Self::compile_in(engine::default_compiler(), source)
+    }
+
+    /// Compiles and validates `source` under `limits` (parse-time limits such as
+    /// expression depth and the number of script functions apply here).
+    pub fn compile_with(source: &str, limits: &Limits) -> Result<Plan, PlanError> {
+        Self::compile_in(&engine::sandbox(limits), source)
+    }
+
+    fn compile_in(engine: &rhai::Engine, source: &str) -> Result<Plan, PlanError> {
+        let ast = engine.compile(source).map_err(|e| {
+            let mut message = e.err_type().to_string();
+            if let rhai::ParseErrorType::Reserved(word) = e.err_type() {
+                if let Some((_, why)) = FORBIDDEN.iter().find(|(n, _)| n == word) {
+                    message = format!("{message}: {why}");
+                }
+            }
+            PlanError::Syntax {
+                span: Span::from_position(e.position()),
+                message,
+            }
+        })?;
+        let calls =
+            validate(source, &ast).map_err(|violations| PlanError::Rejected { violations })?;
+        Ok(Plan {
+            source: source.to_string(),
+            ast,
+            calls,
+        })
+    }
+
+    /// The script text.
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Every library call written in the script, in source order.
+    pub fn library_calls(&self) -> &[CallSite] {
+        &self.calls
+    }
+
+    pub(crate) fn ast(&self) -> &AST {
+        &self.ast
+    }
+}
