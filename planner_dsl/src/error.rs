@@ -83,6 +83,11 @@ pub enum ViolationKind {
     /// Closures and anonymous functions (`|x| ...`).
     #[error("anonymous functions (closures) are not allowed; define a named `fn` instead")]
     Closure,
+    /// Assignment to an indexed element (`a[i] = v`, `m[k] = v`): Rhai does not
+    /// check the size of the container there, so a loop could grow a map without
+    /// bound.
+    #[error("assigning to `x[...]` is not allowed; build arrays with push() and maps with `#{{...}}` or `m.key = value`")]
+    IndexAssignment,
     /// A script function that redefines a library function or `agent`.
     #[error("`{name}` is reserved: {reason}")]
     Reserved {
@@ -117,6 +122,14 @@ pub enum PlanError {
         /// Rhai's message.
         message: String,
     },
+    /// The script is longer than [`crate::Limits::max_source_bytes`].
+    #[error("the script is {bytes} bytes long; plans may be at most {limit} bytes")]
+    TooLong {
+        /// Script length.
+        bytes: usize,
+        /// The limit.
+        limit: usize,
+    },
     /// The script parses but calls things it may not; every violation is listed.
     #[error("plan rejected ({} problem{}):\n{}", violations.len(), if violations.len() == 1 { "" } else { "s" }, list(violations))]
     Rejected {
@@ -137,6 +150,7 @@ impl PlanError {
     pub fn spans(&self) -> Vec<Span> {
         match self {
             PlanError::Syntax { span, .. } => vec![*span],
+            PlanError::TooLong { .. } => vec![Span { line: 1, col: 1 }],
             PlanError::Rejected { violations } => violations.iter().map(|v| v.span).collect(),
         }
     }

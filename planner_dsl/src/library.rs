@@ -25,6 +25,15 @@ const MAX_NAME_LEN: usize = 200;
 /// Longest `say` text kept.
 const MAX_SAY_LEN: usize = 2_000;
 
+/// A number for messages: plain when moderate, scientific when huge.
+fn num(x: f64) -> String {
+    if x.is_finite() && x.abs() >= 1e6 {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 /// Why a library call failed.
 #[derive(Debug)]
 struct CallError {
@@ -308,7 +317,7 @@ impl<'a> Host<'a> {
                     return Err(arg_err(
                         spec,
                         0,
-                        format!("of {a} degrees is absurd (limit ±{MAX_ANGLE_DEG})"),
+                        format!("of {} degrees is absurd (limit ±{MAX_ANGLE_DEG})", num(a)),
                     ));
                 }
                 if name == "turn" {
@@ -325,7 +334,11 @@ impl<'a> Host<'a> {
                     return Err(arg_err(
                         spec,
                         0,
-                        format!("of {d} m is absurd (limit ±{} m)", map_core::MAX_FORWARD_M),
+                        format!(
+                            "of {} m is absurd (limit ±{} m)",
+                            num(d),
+                            map_core::MAX_FORWARD_M
+                        ),
                     ));
                 }
                 let rep = self.robot.move_forward(d).map_err(robot_err)?;
@@ -504,7 +517,7 @@ impl<'a> Host<'a> {
             return Err(arg_err(
                 spec,
                 idx,
-                format!("of {k} is out of range: use k >= 1 for the k-th, 0 for the nearest, -1 for the last"),
+                format!("of {} is out of range: use k >= 1 for the k-th, 0 for the nearest, -1 for the last", num(k as f64)),
             ));
         }
         Ok(k)
@@ -624,7 +637,12 @@ impl<'a> Host<'a> {
                 idx,
                 format!(
                     "[{}, {}] is absurd: the map spans x {}..{}, y {}..{} m",
-                    xy[0], xy[1], b[0], b[2], b[1], b[3]
+                    num(xy[0]),
+                    num(xy[1]),
+                    b[0],
+                    b[2],
+                    b[1],
+                    b[3]
                 ),
             ));
         }

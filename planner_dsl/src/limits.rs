@@ -28,6 +28,8 @@ pub struct Limits {
     pub max_functions: usize,
     /// Robot function library calls per run (bounds trace and trajectory growth).
     pub max_library_calls: usize,
+    /// Longest script accepted, in bytes (checked before parsing).
+    pub max_source_bytes: usize,
     /// Wall-clock budget for the script's own work, not counting the time spent
     /// inside robot function library calls (a real robot's moves take minutes).
     pub deadline: Duration,
@@ -46,6 +48,7 @@ impl Default for Limits {
             max_variables: 256,
             max_functions: 64,
             max_library_calls: 1_000,
+            max_source_bytes: 64 * 1024,
             deadline: Duration::from_millis(500),
         }
     }

@@ -29,16 +29,22 @@ impl Plan {
     /// # Ok::<(), PlanError>(())
     /// ```
     pub fn compile(source: &str) -> Result<Plan, PlanError> {
-        Self::compile_in(engine::default_compiler(), source)
+        Self::compile_in(engine::default_compiler(), &Limits::default(), source)
     }
 
     /// Compiles and validates `source` under `limits` (parse-time limits such as
     /// expression depth and the number of script functions apply here).
     pub fn compile_with(source: &str, limits: &Limits) -> Result<Plan, PlanError> {
-        Self::compile_in(&engine::sandbox(limits), source)
+        Self::compile_in(&engine::sandbox(limits), limits, source)
     }
 
-    fn compile_in(engine: &rhai::Engine, source: &str) -> Result<Plan, PlanError> {
+    fn compile_in(engine: &rhai::Engine, limits: &Limits, source: &str) -> Result<Plan, PlanError> {
+        if source.len() > limits.max_source_bytes {
+            return Err(PlanError::TooLong {
+                bytes: source.len(),
+                limit: limits.max_source_bytes,
+            });
+        }
         let ast = engine.compile(source).map_err(|e| {
             let mut message = e.err_type().to_string();
             if let rhai::ParseErrorType::Reserved(word) = e.err_type() {

@@ -232,6 +232,9 @@ impl Walker<'_> {
                     self.reserved_var(counter.name.as_str(), *pos);
                 }
             }
+            ASTNode::Stmt(Stmt::Assignment(x)) if has_index(&x.1.lhs) => {
+                self.push(x.1.lhs.position(), ViolationKind::IndexAssignment);
+            }
             ASTNode::Expr(Expr::FnCall(x, pos)) => self.plain_call(x, *pos),
             ASTNode::Expr(Expr::MethodCall(x, pos)) => {
                 let on_agent = receiver(path).is_some_and(is_agent);
@@ -242,6 +245,15 @@ impl Walker<'_> {
             }
             _ => {}
         }
+    }
+}
+
+/// Whether an assignment target writes through an index (`a[i]`, `m.a[k]`).
+fn has_index(e: &Expr) -> bool {
+    match e {
+        Expr::Index(..) => true,
+        Expr::Dot(bin, ..) => has_index(&bin.lhs) || has_index(&bin.rhs),
+        _ => false,
     }
 }
 
