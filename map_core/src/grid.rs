@@ -28,7 +28,11 @@ pub struct Grid<T> {
 
 impl<T: Clone> Grid<T> {
     pub fn new(rows: usize, cols: usize, fill: T) -> Self {
-        Self { rows, cols, data: vec![fill; rows * cols] }
+        Self {
+            rows,
+            cols,
+            data: vec![fill; rows * cols],
+        }
     }
 }
 
@@ -104,11 +108,18 @@ impl<T> Grid<T> {
     /// Iterate `(cell, &value)` in row-major order.
     pub fn iter_cells(&self) -> impl Iterator<Item = (Cell, &T)> + '_ {
         let cols = self.cols.max(1);
-        self.data.iter().enumerate().map(move |(i, v)| (Cell::new(i / cols, i % cols), v))
+        self.data
+            .iter()
+            .enumerate()
+            .map(move |(i, v)| (Cell::new(i / cols, i % cols), v))
     }
 
     pub fn map<U>(&self, f: impl Fn(&T) -> U) -> Grid<U> {
-        Grid { rows: self.rows, cols: self.cols, data: self.data.iter().map(f).collect() }
+        Grid {
+            rows: self.rows,
+            cols: self.cols,
+            data: self.data.iter().map(f).collect(),
+        }
     }
 }
 
@@ -156,12 +167,18 @@ impl GridFrame {
 
     /// Fractional (row, col) of a world point (may lie outside the grid).
     pub fn to_grid_f(&self, p: Point) -> (f64, f64) {
-        ((self.origin.y - p.y) / self.cell_size, (p.x - self.origin.x) / self.cell_size)
+        (
+            (self.origin.y - p.y) / self.cell_size,
+            (p.x - self.origin.x) / self.cell_size,
+        )
     }
 
     /// World point of fractional grid coordinates (row, col), cell centres at +0.5.
     pub fn from_grid_f(&self, row: f64, col: f64) -> Point {
-        Point::new(self.origin.x + col * self.cell_size, self.origin.y - row * self.cell_size)
+        Point::new(
+            self.origin.x + col * self.cell_size,
+            self.origin.y - row * self.cell_size,
+        )
     }
 
     /// The cell containing `p`, or `None` outside the grid (or for non-finite input).
@@ -211,6 +228,9 @@ mod tests {
     fn non_finite_points_have_no_cell() {
         let f = GridFrame::from_bounds([0.0, 0.0, 2.0, 1.0], 0.5);
         assert_eq!(f.cell_at(Point::new(f64::NAN, 0.0)), None);
-        assert_eq!(f.clamp_cell(Point::new(f64::INFINITY, -5.0)), Cell::new(1, 0));
+        assert_eq!(
+            f.clamp_cell(Point::new(f64::INFINITY, -5.0)),
+            Cell::new(1, 0)
+        );
     }
 }

@@ -22,11 +22,12 @@ mod goals;
 mod grid;
 mod map;
 mod matcher;
-mod persist;
 mod npy;
+mod persist;
 mod planner;
 mod query;
 mod render;
+mod robot;
 mod scene;
 
 pub use crate::geometry::{
@@ -43,14 +44,18 @@ pub use crate::matcher::{
     COLOUR_WORDS,
 };
 pub use crate::npy::{read_npy, read_npy_from, write_npy, write_npy_to, NpyElement, NpyError};
+pub use crate::persist::{JsonLocation, PersistError, MAP_FORMAT};
 pub use crate::planner::{
     astar, inflate, inflate_m, line_of_sight, octile, polyline_len, supercover_cells, GridPath,
     GridPlanner, Passability, PlanError, WorldPath,
 };
-pub use crate::persist::{JsonLocation, PersistError, MAP_FORMAT};
 pub use crate::query::{ordinal_word, ObjectOrder, QueryError};
 pub use crate::render::{
-    auto_scale, colour_rgb, render_png, render_rgb, RenderError, RenderOptions, RenderOverlay,
-    FINAL_RGB, MAX_SIDE_PX, PALETTE, PATH_RGB, START_RGB, STOP_RGB, UNKNOWN_RGB, WALL_RGB,
+    auto_scale, colour_rgb, render_png, render_rgb, render_trajectory_png, RenderError,
+    RenderOptions, RenderOverlay, FINAL_RGB, MAX_SIDE_PX, PALETTE, PATH_RGB, START_RGB, STOP_RGB,
+    UNKNOWN_RGB, WALL_RGB,
+};
+pub use crate::robot::{
+    MoveReport, Robot, RobotError, SimRobot, Stop, StopTarget, Trajectory, MAX_FORWARD_M,
 };
 pub use crate::scene::{Scene, SceneError, SceneLocation, SceneObject, SCENE_FORMAT};

@@ -24,6 +24,7 @@ use image::{Rgb, RgbImage};
 use crate::geometry::{Point, Pose};
 use crate::grid::Cell;
 use crate::map::IvlMap;
+use crate::robot::Trajectory;
 
 /// What to draw on top of the map: a robot's path, its stops and its final pose.
 #[derive(Debug, Clone, Copy, Default)]
@@ -160,6 +161,28 @@ pub fn render_png(
             path: path.to_path_buf(),
             source,
         })
+}
+
+/// Render a map with a recorded trajectory (path, numbered stops, final pose).
+pub fn render_trajectory_png(
+    map: &IvlMap,
+    trajectory: &Trajectory,
+    opts: &RenderOptions,
+    path: impl AsRef<Path>,
+) -> Result<(), RenderError> {
+    let pts: Vec<Point> = trajectory.path.iter().map(|&p| Point::from(p)).collect();
+    let stops: Vec<(Pose, String)> = trajectory
+        .stops
+        .iter()
+        .map(|s| (Pose::new(s.pose[0], s.pose[1], s.pose[2]), s.call.clone()))
+        .collect();
+    let f = trajectory.final_pose;
+    let overlay = RenderOverlay {
+        path: &pts,
+        stops: &stops,
+        final_pose: Some(Pose::new(f[0], f[1], f[2])),
+    };
+    render_png(map, &overlay, opts, path)
 }
 
 /// Render to an RGB image: `cols * scale` by `rows * scale` pixels, plus a legend
