@@ -225,15 +225,15 @@ impl Walker<'_> {
         let Some(node) = path.last() else { return };
         match node {
             ASTNode::Stmt(Stmt::FnCall(x, pos)) => self.plain_call(x, *pos),
-            ASTNode::Stmt(Stmt::Var(x, _, pos)) => self.reserved_var(x.0.name.as_str(), *pos),
-            ASTNode::Stmt(Stmt::For(x, pos)) => {
-                self.reserved_var(x.0.name.as_str(), *pos);
+            ASTNode::Stmt(Stmt::Var(x, ..)) => self.reserved_var(x.0.name.as_str(), x.0.pos),
+            ASTNode::Stmt(Stmt::For(x, _)) => {
+                self.reserved_var(x.0.name.as_str(), x.0.pos);
                 if let Some(counter) = &x.1 {
-                    self.reserved_var(counter.name.as_str(), *pos);
+                    self.reserved_var(counter.name.as_str(), counter.pos);
                 }
             }
             ASTNode::Stmt(Stmt::Assignment(x)) if has_index(&x.1.lhs) => {
-                self.push(x.1.lhs.position(), ViolationKind::IndexAssignment);
+                self.push(x.1.lhs.start_position(), ViolationKind::IndexAssignment);
             }
             ASTNode::Expr(Expr::FnCall(x, pos)) => self.plain_call(x, *pos),
             ASTNode::Expr(Expr::MethodCall(x, pos)) => {
@@ -343,6 +343,7 @@ pub(crate) fn validate(source: &str, ast: &AST) -> Result<Vec<CallSite>, Vec<Vio
         true
     });
     if w.violations.is_empty() {
+        w.calls.sort_by_key(|c| c.span);
         Ok(w.calls)
     } else {
         w.violations.sort_by_key(|v| v.span);

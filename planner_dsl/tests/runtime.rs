@@ -1,0 +1,163 @@
+//! Running plans: runtime errors stop where they are and keep the trace and
+//! trajectory; dry runs never move the real robot; traces serialise.
+
+mod common;
+
+use common::world;
+use map_core::Robot;
+use planner_dsl::{dry_run, run, Limits, Plan, RunOutcome, RuntimeErrorKind, Span};
+
+#[test]
+fn runtime_error_stops_the_plan_and_keeps_what_was_done() {
+    let (map, mut robot) = world("flat-a");
+    let plan = Plan::compile(
+        "agent.move_to_object(\"fridge\");\nlet t = agent.get_obj_attributes(\"table\", 3, \"yellow\");\nagent.move_to_object(t);\nsay(\"never\");",
+    )
+    .unwrap();
+    let out = run(&plan, &map, &mut robot, &Limits::default());
+    let e = out.error.clone().expect("ordinal past count");
+    assert_eq!(e.span, Span { line: 2, col: 15 });
+    assert_eq!(e.kind, RuntimeErrorKind::Map);
+    assert_eq!(e.function.as_deref(), Some("get_obj_attributes"));
+    assert_eq!(e.message, "there are 2 yellow tables; asked for the 3rd");
+    assert_eq!(
+        e.to_string(),
+        "line 2, column 15: get_obj_attributes: there are 2 yellow tables; asked for the 3rd"
+    );
+    // The first move happened and is kept; nothing after the error ran.
+    assert_eq!(out.trace.len(), 2);
+    assert_eq!(out.trace[1].error.as_deref(), Some(e.message.as_str()));
+    assert!(out.said.is_empty());
+    let traj = robot.trajectory();
+    assert_eq!(traj.stops.len(), 1);
+    assert_eq!(traj.error.as_deref(), Some(e.to_string().as_str()));
+    assert_eq!(traj.script, plan.source());
+    assert_eq!(out.final_pose, robot.pose().to_array());
+}
+
+#[test]
+fn error_inside_a_script_function_points_at_the_inner_call() {
+    let (map, mut robot) = world("flat-a");
+    let plan =
+        Plan::compile("fn walk(n) {\n    agent.move_forward(n);\n}\nwalk(\"far\");").unwrap();
+    let out = run(&plan, &map, &mut robot, &Limits::default());
+    let e = out.error.expect("bad argument");
+    assert_eq!(e.kind, RuntimeErrorKind::Argument);
+    assert_eq!(e.span, Span { line: 2, col: 11 });
+    assert_eq!(
+        e.message,
+        "argument `dist` must be a number (metres), got string \"far\""
+    );
+}
+
+#[test]
+fn script_errors_carry_positions() {
+    let (map, mut robot) = world("flat-a");
+    let plan = Plan::compile("let a = [1, 2];\nlet b = a[5];").unwrap();
+    let out = run(&plan, &map, &mut robot, &Limits::default());
+    let e = out.error.expect("index out of bounds");
+    assert_eq!(e.kind, RuntimeErrorKind::Script);
+    assert_eq!(e.span.line, 2);
+    assert!(e.message.contains("out of bounds"), "{}", e.message);
+    assert!(
+        !e.message.contains("(line"),
+        "position is not repeated: {}",
+        e.message
+    );
+}
+
+#[test]
+fn dry_run_previews_without_moving_the_real_robot() {
+    let (map, robot) = world("flat-a");
+    let plan =
+        Plan::compile("agent.move_to_object(\"bed\");\nagent.turn(45);\nagent.move_forward(0.5);")
+            .unwrap();
+    let before = robot.pose();
+    let preview = dry_run(&plan, &map, &robot, &Limits::default());
+    assert!(preview.outcome.is_ok(), "{:?}", preview.outcome.error);
+    assert_eq!(robot.pose(), before);
+    assert!(robot.trajectory().stops.is_empty());
+    assert_eq!(preview.trajectory.stops.len(), 1);
+    assert!(preview.trajectory.length_m > 1.0);
+    assert_eq!(preview.trajectory.final_pose, preview.outcome.final_pose);
+    // The same plan run for real ends in the same place.
+    let mut real = robot.clone();
+    let out = run(&plan, &map, &mut real, &Limits::default());
+    assert_eq!(out.final_pose, preview.outcome.final_pose);
+}
+
+#[test]
+fn trace_records_calls_and_round_trips_through_json() {
+    let (map, mut robot) = world("flat-a");
+    let plan = Plan::compile(
+        "let s = get_obj_attributes(\"sofa\", 1, \"red\");\nlet p = get_specified_obj_pos(s);\nmove_to([p[0], p[1] + 1.2]);\nsay(s);",
+    )
+    .unwrap();
+    let out = run(&plan, &map, &mut robot, &Limits::default());
+    assert!(out.is_ok(), "{:?}", out.error);
+    let t = &out.trace;
+    assert_eq!(t.len(), 4);
+    assert_eq!(
+        t[0].args,
+        [serde_json::json!("sofa"), 1.into(), "red".into()]
+    );
+    assert_eq!(t[0].result["name"], "sofa");
+    assert_eq!(t[0].result["id"], 1);
+    assert_eq!(t[1].result, serde_json::json!([2.6, 0.75]));
+    assert_eq!(t[2].span, Span { line: 3, col: 1 });
+    assert!(
+        (t[2].pose_after[1] - 1.95).abs() < 0.1,
+        "{:?}",
+        t[2].pose_after
+    );
+    assert_eq!(out.said, ["red sofa #2"]);
+    let json = serde_json::to_string(&out).unwrap();
+    let back: RunOutcome = serde_json::from_str(&json).unwrap();
+    assert_eq!(back, out);
+}
+
+#[test]
+fn object_record_fields_are_readable() {
+    let (map, mut robot) = world("office-b");
+    let plan = Plan::compile(
+        "let t = agent.get_obj_attributes(\"table\", -1, \"yellow\", \"west_to_east\");\nsay(`${t.name} ${t.colour} ${t.color} ${t.label_id} ${t.id} ${t.count} ${t.position[0]}`);",
+    )
+    .unwrap();
+    let out = run(&plan, &map, &mut robot, &Limits::default());
+    assert!(out.is_ok(), "{:?}", out.error);
+    // The easternmost yellow table of office-b is table 15 at x = 12.8.
+    let inst = map.instance_by_id(15).unwrap();
+    assert_eq!(
+        out.said[0],
+        format!(
+            "table yellow yellow {} 15 {} 12.8",
+            inst.label_id, inst.num_of_same_class
+        )
+    );
+}
+
+#[test]
+fn same_limits_in_debug_and_release() {
+    // Limits are explicit values, never Rhai's profile-dependent defaults.
+    let l = Limits::default();
+    assert_eq!(
+        (
+            l.max_operations,
+            l.max_call_levels,
+            l.max_expr_depth,
+            l.max_function_expr_depth
+        ),
+        (200_000, 32, 48, 32)
+    );
+    let deep = format!(
+        "fn f(n) {{ if n > 0 {{ f(n - 1) }} }}\nf({});",
+        l.max_call_levels - 2
+    );
+    let (map, mut robot) = world("flat-a");
+    let out = run(&Plan::compile(&deep).unwrap(), &map, &mut robot, &l);
+    assert!(
+        out.is_ok(),
+        "recursion within the limit works: {:?}",
+        out.error
+    );
+}
