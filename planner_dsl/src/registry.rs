@@ -385,7 +385,7 @@ static REGISTRY: &[FunctionSpec] = &[
         "move_to_object",
         OBJ,
         "()",
-        "move to the object (the nearest reachable point next to it)",
+        "move to the object (the nearest reachable point next to it), or into a named region such as \"kitchen\"",
         "agent.move_to_object(table);",
         true,
     ),

@@ -235,6 +235,9 @@ impl Walker<'_> {
             ASTNode::Stmt(Stmt::Assignment(x)) if has_index(&x.1.lhs) => {
                 self.push(x.1.lhs.start_position(), ViolationKind::IndexAssignment);
             }
+            ASTNode::Stmt(Stmt::Assignment(x)) if is_agent(&x.1.lhs) => {
+                self.reserved_var("agent", x.1.lhs.start_position());
+            }
             ASTNode::Expr(Expr::FnCall(x, pos)) => self.plain_call(x, *pos),
             ASTNode::Expr(Expr::MethodCall(x, pos)) => {
                 let on_agent = receiver(path).is_some_and(is_agent);

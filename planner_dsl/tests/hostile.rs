@@ -102,6 +102,20 @@ fn hostile_corpus_ends_quickly_with_the_expected_error() {
         worst.as_secs_f64() * 1e3,
         files.len()
     );
+    // Bounded memory: the whole corpus runs in a small, fixed peak footprint.
+    let peak_kb = std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| {
+                l.split_whitespace()
+                    .nth(1)
+                    .and_then(|v| v.parse::<u64>().ok())
+            })
+        });
+    if let Some(peak_kb) = peak_kb {
+        println!("peak RSS: {} MiB", peak_kb / 1024);
+        assert!(peak_kb < 512 * 1024, "peak RSS {peak_kb} kB");
+    }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
