@@ -47,7 +47,7 @@ impl Default for Limits {
             max_map_size: 1_000,
             max_variables: 256,
             max_functions: 64,
-            max_library_calls: 1_000,
+            max_library_calls: 200,
             max_source_bytes: 64 * 1024,
             deadline: Duration::from_millis(500),
         }

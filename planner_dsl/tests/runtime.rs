@@ -161,3 +161,22 @@ fn same_limits_in_debug_and_release() {
         out.error
     );
 }
+
+#[test]
+fn plans_and_outcomes_cross_threads() {
+    fn send_sync<T: Send + Sync>() {}
+    send_sync::<Plan>();
+    send_sync::<RunOutcome>();
+    send_sync::<planner_dsl::PlanError>();
+    send_sync::<Limits>();
+    // A plan compiled on one thread runs on another.
+    let plan = Plan::compile("agent.turn(90);").unwrap();
+    let heading = std::thread::spawn(move || {
+        let (map, mut robot) = world("flat-a");
+        run(&plan, &map, &mut robot, &Limits::default());
+        robot.pose().heading
+    })
+    .join()
+    .unwrap();
+    assert!((heading - 90.0).abs() < 1e-9);
+}
