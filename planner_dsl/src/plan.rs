@@ -52,10 +52,15 @@ impl Plan {
                     message = format!("{message}: {why}");
                 }
             }
-            PlanError::Syntax {
-                span: Span::from_position(e.position()),
-                message,
+            let span = Span::from_position(e.position());
+            let line = source
+                .lines()
+                .nth(span.line.saturating_sub(1))
+                .unwrap_or("");
+            if let Some(hint) = python_hint(&message, line) {
+                message = format!("{message}; {hint}");
             }
+            PlanError::Syntax { span, message }
         })?;
         let calls =
             validate(source, &ast).map_err(|violations| PlanError::Rejected { violations })?;
@@ -78,5 +83,48 @@ impl Plan {
 
     pub(crate) fn ast(&self) -> &AST {
         &self.ast
+    }
+}
+
+/// A hint for common Python habits in LLM-written scripts, from the parse error and
+/// the offending line.
+fn python_hint(message: &str, line: &str) -> Option<&'static str> {
+    let line = line.trim_end();
+    if message.starts_with("Invalid character: '") {
+        Some("strings use double quotes in Rhai: \"table\"")
+    } else if message.contains("Expecting '{'") && (line.ends_with(':') || line.contains(" range("))
+    {
+        Some("Rhai blocks use braces, not ':' and indentation: `for i in 0..8 { agent.turn(90); }`")
+    } else if message.contains("Expecting ';'") {
+        Some("end each statement with ';' (one call per statement)")
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn syntax(src: &str) -> (Span, String) {
+        match Plan::compile(src) {
+            Err(PlanError::Syntax { span, message }) => (span, message),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn python_habits_get_hints() {
+        let (span, m) = syntax("agent.get_obj_attributes('table', 3, 'yellow')");
+        assert_eq!(span, Span { line: 1, col: 26 });
+        assert!(
+            m.ends_with("strings use double quotes in Rhai: \"table\""),
+            "{m}"
+        );
+        let (span, m) = syntax("let x = 1;\nfor i in range(8):\n    agent.turn(90)");
+        assert_eq!(span.line, 2);
+        assert!(m.contains("for i in 0..8 {"), "{m}");
+        let (_, m) = syntax("agent.face(obj_attr), agent.turn(-90)");
+        assert!(m.contains("end each statement with ';'"), "{m}");
     }
 }
