@@ -241,12 +241,23 @@ pub(crate) fn sandbox(limits: &Limits) -> Engine {
     e.set_optimization_level(OptimizationLevel::None);
     e.set_fail_on_invalid_map_property(true);
     e.set_allow_looping(true);
+    // Undefined variables are compile errors (before the robot moves), not
+    // failures half-way through a plan.
+    e.set_strict_variables(true);
     // `agent` resolves everywhere, also inside script-defined functions.
     #[allow(deprecated)] // volatile API, not deprecated (Rhai's own note)
     e.on_var(|name, _, _| {
         Ok((name == "agent").then(|| Dynamic::from(AgentHandle).into_read_only()))
     });
     e
+}
+
+/// The scope plans are compiled against: just the constant `agent` (so strict
+/// variables accepts it; at run time `on_var` supplies it, also inside functions).
+pub(crate) fn compile_scope() -> rhai::Scope<'static> {
+    let mut scope = rhai::Scope::new();
+    scope.push_constant("agent", AgentHandle);
+    scope
 }
 
 /// The engine used to compile with default limits (built once).

@@ -45,23 +45,25 @@ impl Plan {
                 limit: limits.max_source_bytes,
             });
         }
-        let ast = engine.compile(source).map_err(|e| {
-            let mut message = e.err_type().to_string();
-            if let rhai::ParseErrorType::Reserved(word) = e.err_type() {
-                if let Some((_, why)) = FORBIDDEN.iter().find(|(n, _)| n == word) {
-                    message = format!("{message}: {why}");
+        let ast = engine
+            .compile_with_scope(&engine::compile_scope(), source)
+            .map_err(|e| {
+                let mut message = e.err_type().to_string();
+                if let rhai::ParseErrorType::Reserved(word) = e.err_type() {
+                    if let Some((_, why)) = FORBIDDEN.iter().find(|(n, _)| n == word) {
+                        message = format!("{message}: {why}");
+                    }
                 }
-            }
-            let span = Span::from_position(e.position());
-            let line = source
-                .lines()
-                .nth(span.line.saturating_sub(1))
-                .unwrap_or("");
-            if let Some(hint) = python_hint(&message, line) {
-                message = format!("{message}; {hint}");
-            }
-            PlanError::Syntax { span, message }
-        })?;
+                let span = Span::from_position(e.position());
+                let line = source
+                    .lines()
+                    .nth(span.line.saturating_sub(1))
+                    .unwrap_or("");
+                if let Some(hint) = python_hint(&message, line) {
+                    message = format!("{message}; {hint}");
+                }
+                PlanError::Syntax { span, message }
+            })?;
         let calls =
             validate(source, &ast).map_err(|violations| PlanError::Rejected { violations })?;
         Ok(Plan {
@@ -124,7 +126,7 @@ mod tests {
         let (span, m) = syntax("let x = 1;\nfor i in range(8):\n    agent.turn(90)");
         assert_eq!(span.line, 2);
         assert!(m.contains("for i in 0..8 {"), "{m}");
-        let (_, m) = syntax("agent.face(obj_attr), agent.turn(-90)");
+        let (_, m) = syntax("let obj_attr = 1;\nagent.face(obj_attr), agent.turn(-90)");
         assert!(m.contains("end each statement with ';'"), "{m}");
     }
 }

@@ -141,3 +141,16 @@ fn plan_error_display_lists_every_problem() {
     assert_eq!(json["kind"], "rejected");
     assert_eq!(json["violations"][1]["span"]["line"], 2);
 }
+
+#[test]
+fn undefined_variables_are_caught_before_running() {
+    match Plan::compile("let t = agent.get_obj_attributes(\"table\");\nagent.face(obj_attr);") {
+        Err(PlanError::Syntax { span, message }) => {
+            assert_eq!(span, Span { line: 2, col: 12 });
+            assert_eq!(message, "Undefined variable: obj_attr");
+        }
+        other => panic!("{other:?}"),
+    }
+    // `agent` is known everywhere, also inside script functions.
+    Plan::compile("fn f(o) { agent.face(o); }\nf(\"tv\");").unwrap();
+}
