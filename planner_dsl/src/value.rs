@@ -38,8 +38,26 @@ impl fmt::Display for ObjectRecord {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct AgentHandle;
 
+/// Longest array or map kept whole in the trace; longer ones keep their head and a
+/// note of how many elements were left out.
+const TRACE_MAX_ITEMS: usize = 32;
+/// Longest string kept whole in the trace, in bytes.
+const TRACE_MAX_STRING: usize = 256;
+
+fn short_string(s: &str) -> serde_json::Value {
+    if s.len() <= TRACE_MAX_STRING {
+        return serde_json::Value::String(s.to_string());
+    }
+    let mut cut = TRACE_MAX_STRING;
+    while !s.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    serde_json::Value::String(format!("{}… ({} bytes)", &s[..cut], s.len()))
+}
+
 /// Converts a script value to JSON for the trace (numbers, strings, arrays, maps,
-/// object records; anything else as its display string).
+/// object records; anything else as its display string). Large values are
+/// abbreviated so that the trace stays small whatever a script passes.
 pub(crate) fn to_json(v: &Dynamic) -> serde_json::Value {
     use serde_json::Value;
     if v.is_unit() {
@@ -60,13 +78,33 @@ pub(crate) fn to_json(v: &Dynamic) -> serde_json::Value {
         return Value::String(c.to_string());
     }
     if let Some(s) = v.read_lock::<rhai::ImmutableString>() {
-        return Value::String(s.to_string());
+        return short_string(&s);
     }
     if let Some(a) = v.read_lock::<rhai::Array>() {
-        return Value::Array(a.iter().map(to_json).collect());
+        let mut out: Vec<Value> = a.iter().take(TRACE_MAX_ITEMS).map(to_json).collect();
+        if a.len() > TRACE_MAX_ITEMS {
+            out.push(Value::String(format!(
+                "… ({} more)",
+                a.len() - TRACE_MAX_ITEMS
+            )));
+        }
+        return Value::Array(out);
     }
     if let Some(m) = v.read_lock::<rhai::Map>() {
-        return Value::Object(m.iter().map(|(k, v)| (k.to_string(), to_json(v))).collect());
+        let mut out: serde_json::Map<String, Value> = m
+            .iter()
+            .take(TRACE_MAX_ITEMS)
+            .map(|(k, v)| {
+                (
+                    short_string(k).as_str().unwrap_or_default().to_string(),
+                    to_json(v),
+                )
+            })
+            .collect();
+        if m.len() > TRACE_MAX_ITEMS {
+            out.insert("…".into(), Value::from(m.len() - TRACE_MAX_ITEMS));
+        }
+        return Value::Object(out);
     }
     if let Some(o) = v.read_lock::<ObjectRecord>() {
         return serde_json::to_value(&*o).unwrap_or(Value::Null);
@@ -74,7 +112,7 @@ pub(crate) fn to_json(v: &Dynamic) -> serde_json::Value {
     if v.is::<AgentHandle>() {
         return Value::String("agent".into());
     }
-    Value::String(v.to_string())
+    short_string(&v.type_name().to_string())
 }
 
 /// `[x, y]` as a script array.
@@ -130,5 +168,11 @@ mod tests {
         assert_eq!(to_json(&Dynamic::UNIT), serde_json::Value::Null);
         assert_eq!(to_json(&Dynamic::from_float(f64::NAN)), "NaN");
         assert_eq!(type_word(&Dynamic::from("x")), "string \"x\"");
+        let big: rhai::Array = (0..100).map(Dynamic::from_int).collect();
+        let j = to_json(&Dynamic::from_array(big));
+        assert_eq!(j.as_array().map(Vec::len), Some(33));
+        assert_eq!(j[32], "… (68 more)");
+        let long = to_json(&Dynamic::from("y".repeat(1000)));
+        assert_eq!(long, format!("{}… (1000 bytes)", "y".repeat(256)));
     }
 }
