@@ -112,7 +112,7 @@ pub(crate) fn to_json(v: &Dynamic) -> serde_json::Value {
     if v.is::<AgentHandle>() {
         return Value::String("agent".into());
     }
-    short_string(&v.type_name().to_string())
+    short_string(v.type_name())
 }
 
 /// `[x, y]` as a script array.
