@@ -1,0 +1,30 @@
+//! The language layer: instruction -> (object, ordinal, colour) tuples -> a checked Rhai plan.
+//!
+//! - [`prompts`]: prompt templates (files in `prompts/`, variants overlay them).
+//! - [`tuples`]: step 1's answer format, parsing and normalisation.
+//! - [`script`]: the code block in step 2's answer, and Python-ism fixups.
+//! - [`checks`]: agreement between the script, the tuples and the map.
+//! - [`pipeline`]: [`extract_tuples`], [`plan_instruction`] (resolution against the map,
+//!   deterministic plans for plain "go to X" sequences, the LLM path with a bounded repair
+//!   loop).
+//! - [`session`]: a chat [`Session`] with history ("go back", "the other one").
+
+mod checks;
+mod pipeline;
+mod prompts;
+mod script;
+mod session;
+mod tuples;
+
+pub use checks::{check_script, library_calls, Arg, Finding, FindingKind, LibCall, Pos};
+pub use pipeline::{
+    extract_tuples, plan_instruction, scene_summary, simple_goto_script, LanguageError, Outcome,
+    PlanContext, PlanOptions, PlanSource, PlannedInstruction, Timing,
+};
+pub use prompts::{PromptError, Prompts, TEMPLATE_NAMES};
+pub use script::{extract_code, pythonic_fixups};
+pub use session::{Session, Turn};
+pub use tuples::{
+    normalise_colour, normalise_object, parse_ordinal, parse_tuples, same_tuples,
+    tuples_paper_form, Tuple, TupleParseError,
+};

@@ -1,0 +1,176 @@
+//! Agreement checks, deterministic plans and tuple resolution on a real example scene.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use agent::{check_script, library_calls, simple_goto_script, Arg, FindingKind, Tuple};
+use map_core::{IvlMap, Scene};
+
+fn flat_a() -> IvlMap {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../examples/scenes/flat-a.scene.json"
+    );
+    IvlMap::from_scene(&Scene::from_path(path).unwrap())
+}
+
+fn kinds(src: &str, tuples: &[Tuple], map: &IvlMap) -> Vec<FindingKind> {
+    check_script(src, tuples, Some(map))
+        .unwrap()
+        .into_iter()
+        .map(|f| f.kind)
+        .collect()
+}
+
+#[test]
+fn agreeing_script_has_no_findings() {
+    let map = flat_a();
+    let tuples = [
+        Tuple::new("table", Some(2), Some("yellow")),
+        Tuple::new("sofa", None, Some("red")),
+    ];
+    let src = "let t = agent.get_obj_attributes(\"table\", 2, \"yellow\");\nagent.move_to_object(t);\nlet s = agent.get_obj_attributes(\"sofa\", 0, \"red\");\nagent.move_to_right(s);\n";
+    assert_eq!(kinds(src, &tuples, &map), vec![]);
+    // Synonyms, plural, "()" for unspecified and default arity are all fine.
+    let src = "let s = get_obj_attributes(\"couches\", (), \"red\");\nface(s);\nlet t = get_obj_attributes(\"table\", 2, \"yellow\", \"near_to_far\");\nface(t);";
+    assert_eq!(kinds(src, &tuples, &map), vec![]);
+}
+
+#[test]
+fn each_disagreement_is_found_with_its_position() {
+    let map = flat_a();
+    let table3 = [Tuple::new("chair", Some(3), Some("red"))];
+    // Ordinal counted from 0.
+    let f = check_script(
+        "let c = agent.get_obj_attributes(\"chair\", 2, \"red\");\nagent.face(c);",
+        &table3,
+        Some(&map),
+    )
+    .unwrap();
+    assert_eq!(f.len(), 1, "{f:?}");
+    assert_eq!(f[0].kind, FindingKind::ZeroBased);
+    assert_eq!(
+        (f[0].pos.unwrap().line, f[0].pos.unwrap().col > 0),
+        (1, true)
+    );
+    assert!(f[0].message.contains("count from 1"), "{}", f[0].message);
+    // Another ordinal.
+    assert!(kinds(
+        "agent.face(agent.get_obj_attributes(\"chair\", 1, \"red\"));",
+        &table3,
+        &map
+    )
+    .contains(&FindingKind::Ordinal));
+    // A colour that disagrees.
+    assert!(kinds(
+        "agent.face(agent.get_obj_attributes(\"chair\", 3, \"black\"));",
+        &table3,
+        &map
+    )
+    .contains(&FindingKind::Colour));
+    // The order where the colour goes (design.md's observed failure).
+    let f = check_script(
+        "let c = agent.get_obj_attributes(\"chair\", 3, \"left_to_right\");\nagent.face(c);",
+        &[Tuple::new("chair", Some(3), None)],
+        Some(&map),
+    )
+    .unwrap();
+    assert_eq!(
+        f.iter().map(|f| f.kind.clone()).collect::<Vec<_>>(),
+        vec![FindingKind::NotAColour]
+    );
+    assert!(f[0].message.contains("4th"), "{}", f[0].message);
+    // An object the instruction never mentions, and the mentioned one left unused.
+    let k = kinds(
+        "agent.move_to_object(agent.get_obj_attributes(\"bed\", 0, \"\"));",
+        &table3,
+        &map,
+    );
+    assert!(
+        k.contains(&FindingKind::NotMentioned) && k.contains(&FindingKind::Unused),
+        "{k:?}"
+    );
+    // A bare name meaning the nearest when the instruction asks for a specific one.
+    assert!(
+        kinds("agent.move_to_object(\"chair\");", &table3, &map).contains(&FindingKind::Ordinal)
+    );
+    // The map: an unknown object, an ordinal past the count, a bad order.
+    let piano = [Tuple::new("piano", None, None)];
+    let f = check_script("agent.move_to_object(\"piano\");", &piano, Some(&map)).unwrap();
+    assert_eq!(f[0].kind, FindingKind::Map);
+    assert!(f[0].message.contains("has no"), "{}", f[0].message);
+    let nine = [Tuple::new("chair", Some(9), None)];
+    let f = check_script(
+        "agent.face(agent.get_obj_attributes(\"chair\", 9, \"\"));",
+        &nine,
+        Some(&map),
+    )
+    .unwrap();
+    assert_eq!(f[0].kind, FindingKind::Map);
+    assert!(
+        f[0].message.contains("there are 8 chairs"),
+        "{}",
+        f[0].message
+    );
+    assert!(kinds(
+        "agent.face(agent.get_obj_attributes(\"chair\", 3, \"red\", \"sideways\"));",
+        &table3,
+        &map
+    )
+    .contains(&FindingKind::BadOrder));
+}
+
+#[test]
+fn variables_and_computed_arguments_are_trusted() {
+    let map = flat_a();
+    let t = [Tuple::new("chair", Some(2), None)];
+    let src =
+        "let k = 1 + 1;\nlet c = agent.get_obj_attributes(\"chair\", k, \"\");\nagent.face(c);";
+    assert_eq!(kinds(src, &t, &map), vec![]);
+    let calls = library_calls(src).unwrap();
+    assert_eq!(calls[0].args[1], Arg::Var("k".into()));
+}
+
+#[test]
+fn regions_are_names_on_the_map() {
+    let map = flat_a();
+    let t = [
+        Tuple::new("kitchen", None, None),
+        Tuple::new("fridge", None, None),
+    ];
+    let src = "agent.move_to_object(\"kitchen\");\nagent.move_to_object(agent.get_obj_attributes(\"fridge\", 0, \"\"));";
+    assert_eq!(kinds(src, &t, &map), vec![]);
+}
+
+#[test]
+fn deterministic_goto_plans_only_when_words_agree() {
+    let map = flat_a();
+    let t = vec![
+        Tuple::new("chair", Some(2), Some("red")),
+        Tuple::new("kitchen", None, None),
+        Tuple::new("table", Some(-1), None),
+    ];
+    let s = simple_goto_script(
+        "Go to the second red chair, then head into the kitchen and then walk to the last table.",
+        &t,
+        Some(&map),
+    )
+    .unwrap();
+    assert_eq!(
+        s,
+        "let target_1 = agent.get_obj_attributes(\"chair\", 2, \"red\");\nagent.move_to_object(target_1);\nagent.move_to_object(\"kitchen\");\nlet target_3 = agent.get_obj_attributes(\"table\", -1, \"\");\nagent.move_to_object(target_3);\n"
+    );
+    assert!(planner_dsl::Plan::compile(&s).is_ok());
+    // A tuple that disagrees with the words (extractor dropped the colour): no template.
+    let wrong = vec![Tuple::new("chair", Some(2), None)];
+    assert_eq!(
+        simple_goto_script("go to the second red chair", &wrong, Some(&map)),
+        None
+    );
+    // Spatial words: not a plain go-to.
+    let one = vec![Tuple::new("sofa", None, Some("red"))];
+    assert_eq!(
+        simple_goto_script("go to the left of the red sofa", &one, Some(&map)),
+        None
+    );
+    assert!(simple_goto_script("go to the red sofa", &one, Some(&map)).is_some());
+    assert_eq!(simple_goto_script("turn left", &[], Some(&map)), None);
+}
