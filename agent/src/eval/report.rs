@@ -1,0 +1,319 @@
+//! The evaluation report (formats.md) and the summary table printed after a run.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use map_core::Trajectory;
+use serde::{Deserialize, Serialize};
+
+use super::score::{nav_scores, ratio};
+
+/// One evaluated case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseResult {
+    /// The case id from the suite.
+    pub id: String,
+    /// Extraction: the tuples matched `expected`; navigation: every subgoal reached.
+    pub ok: bool,
+    /// What the system produced: the tuples (extraction), or `{"tuples", "script"}`
+    /// (navigation); `null` when it produced nothing.
+    pub got: serde_json::Value,
+    /// Time the language layer took for this case (backend calls included), ms.
+    pub latency_ms: u64,
+    /// Why the case failed to produce or run a plan, if it did.
+    pub error: Option<String>,
+    /// The instruction (additive, for reading the report alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub instruction: Option<String>,
+    /// Navigation: the trajectory of the run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trajectory: Option<Trajectory>,
+    /// Navigation: per subgoal, whether it was reached.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reached: Option<Vec<bool>>,
+}
+
+/// The report's summary.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Cases run.
+    pub total: usize,
+    /// Cases ok.
+    pub ok: usize,
+    /// ok / total.
+    pub accuracy: f64,
+    /// Median latency, ms (nearest rank).
+    pub latency_ms_p50: u64,
+    /// 95th percentile latency, ms (nearest rank).
+    pub latency_ms_p95: u64,
+    /// Navigation: T_1..T_K.
+    #[serde(rename = "T", default, skip_serializing_if = "Option::is_none")]
+    pub t: Option<Vec<f64>>,
+    /// Navigation: share of subgoals reached.
+    #[serde(rename = "SR", default, skip_serializing_if = "Option::is_none")]
+    pub sr: Option<f64>,
+}
+
+/// The report file of formats.md.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// The suite file name.
+    pub suite: String,
+    /// The backend name (`llama`, `openai`, `replay`, ...).
+    pub backend: String,
+    /// The model (path or name).
+    pub model: String,
+    /// The prompt variant (label or folder).
+    pub prompts: String,
+    /// `ivlmap` or `vlmap` (the baseline); additive field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method: Option<String>,
+    /// Every case, in suite order.
+    pub cases: Vec<CaseResult>,
+    /// The figures.
+    pub summary: Summary,
+}
+
+impl Report {
+    /// A report from its cases; the summary is computed (navigation figures when any
+    /// case carries `reached`).
+    #[must_use]
+    pub fn new(
+        suite: String,
+        backend: String,
+        model: String,
+        prompts: String,
+        method: Option<String>,
+        cases: Vec<CaseResult>,
+    ) -> Report {
+        let summary = summarise(&cases);
+        Report {
+            suite,
+            backend,
+            model,
+            prompts,
+            method,
+            cases,
+            summary,
+        }
+    }
+
+    /// Writes the report as pretty JSON.
+    ///
+    /// # Errors
+    /// The I/O error, with the path.
+    pub fn write(&self, path: &Path) -> Result<(), std::io::Error> {
+        let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        std::fs::write(path, text + "\n").map_err(|e| {
+            std::io::Error::new(
+                e.kind(),
+                format!("{}: cannot write report: {e}", path.display()),
+            )
+        })
+    }
+
+    /// A short label for table columns: method and prompt variant.
+    #[must_use]
+    pub fn label(&self) -> String {
+        let m = self.method.as_deref().unwrap_or("ivlmap");
+        format!("{m} {}/{}", self.backend, self.prompts)
+    }
+}
+
+/// Nearest-rank percentile of `values` (0 when empty); `p` in (0, 100].
+#[must_use]
+pub fn percentile(values: &[u64], p: f64) -> u64 {
+    if values.is_empty() {
+        return 0;
+    }
+    let mut v = values.to_vec();
+    v.sort_unstable();
+    let rank = ((p / 100.0) * v.len() as f64).ceil() as usize;
+    v[rank.clamp(1, v.len()) - 1]
+}
+
+/// The summary of a list of cases.
+#[must_use]
+pub fn summarise(cases: &[CaseResult]) -> Summary {
+    let lat: Vec<u64> = cases.iter().map(|c| c.latency_ms).collect();
+    let ok = cases.iter().filter(|c| c.ok).count();
+    let reached: Vec<Vec<bool>> = cases.iter().filter_map(|c| c.reached.clone()).collect();
+    let nav = (!reached.is_empty()).then(|| nav_scores(&reached));
+    Summary {
+        total: cases.len(),
+        ok,
+        accuracy: ratio(ok, cases.len()),
+        latency_ms_p50: percentile(&lat, 50.0),
+        latency_ms_p95: percentile(&lat, 95.0),
+        t: nav.as_ref().map(|n| n.t.clone()),
+        sr: nav.map(|n| n.sr),
+    }
+}
+
+/// A plain-text table of the reports side by side (one column per report).
+#[must_use]
+pub fn summary_table(reports: &[Report]) -> String {
+    let mut rows: Vec<(String, Vec<String>)> = vec![
+        ("".into(), reports.iter().map(Report::label).collect()),
+        (
+            "model".into(),
+            reports.iter().map(|r| short_model(&r.model)).collect(),
+        ),
+        (
+            "cases".into(),
+            reports
+                .iter()
+                .map(|r| r.summary.total.to_string())
+                .collect(),
+        ),
+        (
+            "ok".into(),
+            reports
+                .iter()
+                .map(|r| format!("{}/{}", r.summary.ok, r.summary.total))
+                .collect(),
+        ),
+        (
+            "accuracy".into(),
+            reports
+                .iter()
+                .map(|r| format!("{:.3}", r.summary.accuracy))
+                .collect(),
+        ),
+    ];
+    let k_max = reports
+        .iter()
+        .filter_map(|r| r.summary.t.as_ref().map(Vec::len))
+        .max()
+        .unwrap_or(0);
+    for k in 0..k_max {
+        rows.push((
+            format!("T_{}", k + 1),
+            reports
+                .iter()
+                .map(|r| {
+                    r.summary
+                        .t
+                        .as_ref()
+                        .and_then(|t| t.get(k))
+                        .map_or("-".into(), |v| format!("{v:.3}"))
+                })
+                .collect(),
+        ));
+    }
+    if reports.iter().any(|r| r.summary.sr.is_some()) {
+        rows.push((
+            "SR".into(),
+            reports
+                .iter()
+                .map(|r| r.summary.sr.map_or("-".into(), |v| format!("{v:.3}")))
+                .collect(),
+        ));
+    }
+    rows.push((
+        "latency p50 ms".into(),
+        reports
+            .iter()
+            .map(|r| r.summary.latency_ms_p50.to_string())
+            .collect(),
+    ));
+    rows.push((
+        "latency p95 ms".into(),
+        reports
+            .iter()
+            .map(|r| r.summary.latency_ms_p95.to_string())
+            .collect(),
+    ));
+    let w0 = rows.iter().map(|(h, _)| h.len()).max().unwrap_or(0);
+    let widths: Vec<usize> = (0..reports.len())
+        .map(|i| {
+            rows.iter()
+                .map(|(_, c)| c[i].chars().count())
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
+    let mut out = String::new();
+    for (h, cells) in &rows {
+        let _ = write!(out, "{h:<w0$}");
+        for (c, w) in cells.iter().zip(&widths) {
+            let _ = write!(out, "  {c:>w$}");
+        }
+        out.push('\n');
+    }
+    out
+}
+
+fn short_model(m: &str) -> String {
+    Path::new(m)
+        .file_name()
+        .map_or_else(|| m.to_string(), |f| f.to_string_lossy().to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn case(id: &str, ok: bool, ms: u64, reached: Option<Vec<bool>>) -> CaseResult {
+        CaseResult {
+            id: id.into(),
+            ok,
+            got: serde_json::Value::Null,
+            latency_ms: ms,
+            error: None,
+            instruction: None,
+            trajectory: None,
+            reached,
+        }
+    }
+
+    #[test]
+    fn percentiles_are_nearest_rank() {
+        let v: Vec<u64> = (1..=20).collect();
+        assert_eq!(percentile(&v, 50.0), 10);
+        assert_eq!(percentile(&v, 95.0), 19);
+        assert_eq!(percentile(&[7], 95.0), 7);
+        assert_eq!(percentile(&[], 50.0), 0);
+    }
+
+    #[test]
+    fn report_json_has_the_formats_md_fields() {
+        let r = Report::new(
+            "x.nav.jsonl".into(),
+            "replay".into(),
+            "m.gguf".into(),
+            "default".into(),
+            None,
+            vec![
+                case("t1", true, 100, Some(vec![true, true])),
+                case("t2", false, 300, Some(vec![true, false])),
+            ],
+        );
+        let v = serde_json::to_value(&r).unwrap();
+        for k in ["suite", "backend", "model", "prompts", "cases", "summary"] {
+            assert!(v.get(k).is_some(), "{k}");
+        }
+        assert!(v.get("method").is_none());
+        let s = &v["summary"];
+        assert_eq!(s["total"], 2);
+        assert_eq!(s["ok"], 1);
+        assert_eq!(s["accuracy"], 0.5);
+        assert_eq!(s["T"], serde_json::json!([1.0, 0.5]));
+        assert_eq!(s["SR"], 0.75);
+        assert_eq!(s["latency_ms_p50"], 100);
+        assert_eq!(v["cases"][1]["reached"], serde_json::json!([true, false]));
+        let table = summary_table(&[r.clone(), r]);
+        assert!(table.contains("T_2") && table.contains("SR"), "{table}");
+        // An extraction report has no navigation figures.
+        let e = Report::new(
+            "a".into(),
+            "b".into(),
+            "c".into(),
+            "d".into(),
+            None,
+            vec![case("p", true, 5, None)],
+        );
+        let v = serde_json::to_value(&e).unwrap();
+        assert!(v["summary"].get("T").is_none() && v["summary"].get("SR").is_none());
+    }
+}
