@@ -138,6 +138,9 @@ fn regions_are_names_on_the_map() {
     ];
     let src = "agent.move_to_object(\"kitchen\");\nagent.move_to_object(agent.get_obj_attributes(\"fridge\", 0, \"\"));";
     assert_eq!(kinds(src, &t, &map), vec![]);
+    let f = check_script("let k = agent.get_obj_attributes(\"kitchen\", 0, \"\");\nagent.move_to_object(k);\nagent.move_to_object(\"fridge\");", &t, Some(&map)).unwrap();
+    assert_eq!(f.len(), 1, "{f:?}");
+    assert!(f[0].message.contains("is a region"), "{}", f[0].message);
 }
 
 #[test]

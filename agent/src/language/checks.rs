@@ -329,7 +329,18 @@ pub fn check_script(
             }
             // The map.
             if let (Some(m), Some(k), Some(c), Some(o)) = (map, k, &colour, order) {
-                if colour_valid && !(is_region(m, name) && c.is_none() && k == 0) {
+                let region_only = is_region(m, name)
+                    && m.get_obj_attributes(name, 0, None, ObjectOrder::NearToFar, m.start_pose)
+                        .is_err();
+                if region_only {
+                    out.push(Finding {
+                        pos: at,
+                        kind: FindingKind::Map,
+                        message: format!(
+                            "\"{name}\" is a region, not an object: go there with agent.move_to_object(\"{name}\")"
+                        ),
+                    });
+                } else if colour_valid {
                     if let Err(e) = m.get_obj_attributes(name, k, c.as_deref(), o, m.start_pose) {
                         out.push(map_finding(at, name, &e));
                     }
