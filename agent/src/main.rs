@@ -205,8 +205,9 @@ fn main() -> ExitCode {
 }
 
 fn init_logging(verbose: u8) {
+    // llama.cpp warns about harmless model quirks at load time: keep those for -v.
     let level = match verbose {
-        0 => "warn",
+        0 => "warn,llama-cpp-2=error,llama.cpp=error",
         1 => "info",
         2 => "debug",
         _ => "trace",
