@@ -216,15 +216,25 @@ impl LlmBackend for ReplayBackend {
     }
 }
 
-/// Ranks recorded requests by closeness: equal leading messages first, then equal
-/// parameters.
-fn similarity(a: &CompletionRequest, b: &CompletionRequest) -> (usize, usize, usize) {
+/// Ranks recorded requests by closeness: equal leading messages first, then how far the
+/// first differing message agrees, then equal parameters.
+fn similarity(a: &CompletionRequest, b: &CompletionRequest) -> (usize, usize, usize, usize) {
     let lead = a
         .messages
         .iter()
         .zip(&b.messages)
         .take_while(|(x, y)| x == y)
         .count();
+    // How far the first differing message agrees.
+    let chars = match (a.messages.get(lead), b.messages.get(lead)) {
+        (Some(x), Some(y)) if x.role == y.role => x
+            .content
+            .chars()
+            .zip(y.content.chars())
+            .take_while(|(p, q)| p == q)
+            .count(),
+        _ => 0,
+    };
     let same_len = usize::from(a.messages.len() == b.messages.len());
     let params = [
         a.max_tokens == b.max_tokens,
@@ -236,7 +246,7 @@ fn similarity(a: &CompletionRequest, b: &CompletionRequest) -> (usize, usize, us
     .iter()
     .filter(|x| **x)
     .count();
-    (lead, same_len, params)
+    (lead, chars, same_len, params)
 }
 
 /// Says where `asked` first differs from `recorded`.
