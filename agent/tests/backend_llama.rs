@@ -352,7 +352,8 @@ fn one_backend_serves_several_threads() {
     }
 }
 
-/// Prints prompt-processing and generation speed, with and without the prefix cache.
+/// Prints prompt-processing and generation speed, with and without the prefix cache
+/// (`IVLMAP_BENCH_THREADS` overrides the 2 threads).
 #[test]
 fn prefix_cache_speedup() {
     let _g = serial();
@@ -368,6 +369,12 @@ fn prefix_cache_speedup() {
     let run = |cache: bool| {
         let mut cfg = LlamaCppConfig::new(&path);
         cfg.prefix_cache = cache;
+        if let Some(t) = std::env::var("IVLMAP_BENCH_THREADS")
+            .ok()
+            .and_then(|t| t.parse().ok())
+        {
+            cfg.threads = t;
+        }
         let b = LlamaCppBackend::new(cfg).unwrap();
         // Warm-up request (fills the cache for the cached run).
         b.complete(&ask(&prefix, "Instruction: go to the sofa.", 24))
