@@ -423,3 +423,148 @@ fn prefix_cache_speedup() {
         "cache should at least halve prompt time"
     );
 }
+
+/// A second few-shot prompt, different from [`few_shot_prefix`] from its first word: the
+/// shape of the language layer's plan-generation prompt.
+fn plan_prefix() -> String {
+    let mut s = String::from(
+        "Write a navigation plan for the robot as one call per line. Calls: goto(object), \
+         left_of(object), right_of(object), between(a, b), face(object). Objects are written \
+         as colour_name_ordinal. Answer with the plan only.\n\nExamples:\n",
+    );
+    let places = [
+        ("kitchen", "fridge", "white"),
+        ("office", "desk", "brown"),
+        ("bedroom", "bed", "blue"),
+        ("hall", "door", "black"),
+        ("bathroom", "sink", "grey"),
+        ("lounge", "sofa", "red"),
+        ("studio", "easel", "green"),
+    ];
+    for (i, (room, obj, col)) in places.iter().enumerate() {
+        let (_, other, ocol) = places[(i + 2) % places.len()];
+        s.push_str(&format!(
+            "Task: in the {room}, walk up to the {col} {obj}, pass between it and the {ocol} \
+             {other}, then wait facing the {other}.\nPlan:\ngoto({col}_{obj}_1)\n\
+             between({col}_{obj}_1, {ocol}_{other}_1)\nface({ocol}_{other}_1)\n\n"
+        ));
+    }
+    s
+}
+
+fn smol_slots(n_ctx: u32, n_slots: u32) -> Option<LlamaCppBackend> {
+    let path = model(SMOL)?;
+    let mut cfg = LlamaCppConfig::new(path);
+    cfg.n_ctx = n_ctx;
+    cfg.n_slots = n_slots;
+    Some(LlamaCppBackend::new(cfg).unwrap())
+}
+
+#[test]
+fn alternating_prefixes_each_keep_their_cache() {
+    let _g = serial();
+    let Some(warm) = smol_slots(4096, 4) else {
+        return;
+    };
+    let (pa, pb) = (few_shot_prefix(), plan_prefix());
+    let a1 = ask(&pa, "Instruction: go to the second red chair.", 32);
+    let b1 = ask(&pb, "Task: go to the black sofa.", 32);
+    let a2 = ask(
+        &pa,
+        "Instruction: stop between the black sofa and the white counter.",
+        32,
+    );
+    let b2 = ask(&pb, "Task: in the hall, face the third yellow table.", 32);
+    let r_a1 = warm.complete(&a1).unwrap();
+    let r_b1 = warm.complete(&b1).unwrap();
+    let r_a2 = warm.complete(&a2).unwrap();
+    let r_b2 = warm.complete(&b2).unwrap();
+    println!("a1: {r_a1:?}\nb1: {r_b1:?}\na2: {r_a2:?}\nb2: {r_b2:?}");
+    assert!(r_a1.prompt_tokens > 400 && r_b1.prompt_tokens > 400);
+    assert_eq!(r_a1.cached_prompt_tokens, 0);
+    assert!(
+        r_b1.cached_prompt_tokens < 10,
+        "B shares only the template header with A: {r_b1:?}"
+    );
+    // Everything up to the user message is shared: ~25 tokens of instruction differ.
+    for (r, label) in [(&r_a2, "a2"), (&r_b2, "b2")] {
+        assert!(
+            r.cached_prompt_tokens + 40 >= r.prompt_tokens
+                && r.cached_prompt_tokens < r.prompt_tokens,
+            "{label} should reuse its own prefix: {r:?}"
+        );
+    }
+    // The latest A request again (A's slot now holds it) hits all but the last prompt token.
+    let again = warm.complete(&a2).unwrap();
+    assert_eq!(again.cached_prompt_tokens, again.prompt_tokens - 1);
+    assert_eq!(again.text, r_a2.text);
+
+    drop(warm);
+    let fresh = smol_slots(4096, 4).unwrap();
+    let cold_a2 = fresh.complete(&a2).unwrap();
+    let fresh = smol_slots(4096, 4).unwrap();
+    let cold_b2 = fresh.complete(&b2).unwrap();
+    assert_eq!(cold_a2.cached_prompt_tokens, 0);
+    assert_eq!(cold_a2.prompt_tokens, r_a2.prompt_tokens);
+    assert_eq!(
+        cold_a2.text, r_a2.text,
+        "greedy output must not depend on the cache"
+    );
+    assert_eq!(
+        cold_b2.text, r_b2.text,
+        "greedy output must not depend on the cache"
+    );
+}
+
+#[test]
+fn one_slot_loses_the_prefix_when_prompts_alternate() {
+    let _g = serial();
+    let Some(b) = smol_slots(4096, 1) else { return };
+    let (pa, pb) = (few_shot_prefix(), plan_prefix());
+    b.complete(&ask(&pa, "Instruction: go to the sofa.", 8))
+        .unwrap();
+    b.complete(&ask(&pb, "Task: go to the sofa.", 8)).unwrap();
+    let c = b
+        .complete(&ask(&pa, "Instruction: go to the bed.", 8))
+        .unwrap();
+    assert!(c.cached_prompt_tokens < 10, "{c:?}");
+}
+
+#[test]
+fn full_cache_evicts_the_least_recently_used_slot() {
+    let _g = serial();
+    // Room for one few-shot prompt and its answer, not two.
+    let Some(b) = smol_slots(1024, 4) else { return };
+    let (pa, pb) = (few_shot_prefix(), plan_prefix());
+    let a = ask(&pa, "Instruction: go to the second red chair.", 16);
+    let first = b.complete(&a).unwrap();
+    let other = b.complete(&ask(&pb, "Task: go to the sofa.", 16)).unwrap();
+    assert!(
+        first.prompt_tokens + other.prompt_tokens + 32 > 1024,
+        "the two prompts must not fit together: {first:?} {other:?}"
+    );
+    // A's slot was emptied to make room for B: A starts over, with the same answer.
+    let again = b.complete(&a).unwrap();
+    assert!(again.cached_prompt_tokens < 10, "{again:?}");
+    assert_eq!(again.text, first.text);
+    // B was evicted in turn; a short prompt fits beside A and keeps it.
+    b.complete(&ask("Answer.", "Hi", 4)).unwrap();
+    let a_hit = b.complete(&a).unwrap();
+    assert_eq!(
+        a_hit.cached_prompt_tokens,
+        a_hit.prompt_tokens - 1,
+        "{a_hit:?}"
+    );
+}
+
+#[test]
+fn zero_or_too_many_slots_are_config_errors() {
+    let Some(path) = model(SMOL) else { return };
+    let mut cfg = LlamaCppConfig::new(path);
+    cfg.n_slots = 0;
+    let err = LlamaCppBackend::new(cfg.clone()).unwrap_err();
+    assert!(matches!(err, LlmError::Config { .. }), "{err}");
+    cfg.n_slots = 257;
+    let err = LlamaCppBackend::new(cfg).unwrap_err();
+    assert!(matches!(err, LlmError::Config { .. }), "{err}");
+}

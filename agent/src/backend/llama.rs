@@ -4,10 +4,14 @@
 //! borrows the model); callers talk to it through a channel and wait for the reply, so
 //! [`LlamaCppBackend`] is `Send + Sync` and requests are served one at a time.
 //!
-//! Prefix caching: the worker remembers which tokens sit in the KV cache. Each request's
-//! prompt is tokenized in full, the longest common prefix with the cached tokens is kept,
-//! the rest of the cache is dropped, and only the new tokens are evaluated. Prompts that
-//! share a long few-shot prefix therefore pay for it once.
+//! Prefix caching: the KV cache holds several token sequences ("slots", llama.cpp sequence
+//! ids `0..n_slots`, like llama-server's slots) in one unified cache, and the worker
+//! remembers the tokens of each. Each request's prompt is tokenized in full and goes to the
+//! slot sharing the longest common prefix with it (else the least recently used slot); that
+//! slot keeps the common prefix, drops the rest, and only the new tokens are evaluated.
+//! Requests that alternate between different long few-shot prefixes (tuple extraction and
+//! plan generation) therefore each pay for their prefix once. When the cache cannot hold a
+//! new prompt plus its answer, least recently used slots are emptied first.
 //!
 //! Chat template: the model's own (from its GGUF metadata), rendered by llama.cpp's
 //! `llama_chat_apply_template`, which recognises the common template families (ChatML,
@@ -38,6 +42,9 @@ use super::{ChatMessage, Completion, CompletionRequest, FinishReason, LlmBackend
 /// The template used when a model carries none (llama.cpp's built-in ChatML).
 pub const FALLBACK_CHAT_TEMPLATE: &str = "chatml";
 
+/// llama.cpp's `LLAMA_MAX_SEQ`: the most sequences (slots) one context can hold.
+const MAX_SLOTS: u32 = 256;
+
 /// Settings of the local llama.cpp backend.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LlamaCppConfig {
@@ -45,7 +52,8 @@ pub struct LlamaCppConfig {
     pub model_path: PathBuf,
     /// CPU threads for generation and prompt processing (default 2).
     pub threads: u32,
-    /// Context window in tokens: prompt plus answer (default 4096).
+    /// KV cache size in tokens, shared by all slots; one request's prompt plus answer must
+    /// fit in it (default 8192).
     pub n_ctx: u32,
     /// Tokens evaluated per llama.cpp batch while reading the prompt (default 512).
     pub n_batch: u32,
@@ -58,23 +66,27 @@ pub struct LlamaCppConfig {
     /// Overrides the model's chat template: a llama.cpp template name ("chatml", "llama2",
     /// "llama3", ...) or a template string. `None`: the model's own, else ChatML.
     pub chat_template: Option<String>,
-    /// Reuse the KV cache for a prompt prefix shared with the previous request (default on).
+    /// Reuse the KV cache for a prompt prefix shared with an earlier request (default on).
     pub prefix_cache: bool,
+    /// Prompt prefixes kept in the KV cache at once (llama.cpp sequences; default 4).
+    pub n_slots: u32,
 }
 
 impl LlamaCppConfig {
-    /// Defaults for `model_path`: 2 threads, 4096-token context, batch 512, prefix cache on.
+    /// Defaults for `model_path`: 2 threads, 8192-token context, batch 512, prefix cache on
+    /// with 4 slots.
     pub fn new(model_path: impl Into<PathBuf>) -> Self {
         Self {
             model_path: model_path.into(),
             threads: 2,
-            n_ctx: 4096,
+            n_ctx: 8192,
             n_batch: 512,
             top_k: 40,
             top_p: 0.95,
             seed: 42,
             chat_template: None,
             prefix_cache: true,
+            n_slots: 4,
         }
     }
 }
@@ -210,13 +222,22 @@ impl LlamaCppBackend {
     ///
     /// # Errors
     /// [`LlmError::ModelLoad`] (missing or unreadable file, context allocation failure),
-    /// [`LlmError::ChatTemplate`], [`LlmError::Config`] (zero threads/context/batch).
+    /// [`LlmError::ChatTemplate`], [`LlmError::Config`] (zero threads/context/batch/slots,
+    /// or more slots than llama.cpp's limit of 256 sequences).
     pub fn new(config: LlamaCppConfig) -> Result<Self, LlmError> {
-        if config.threads == 0 || config.n_ctx == 0 || config.n_batch == 0 {
+        if config.threads == 0 || config.n_ctx == 0 || config.n_batch == 0 || config.n_slots == 0 {
             return Err(LlmError::Config {
                 message: format!(
-                    "threads ({}), n_ctx ({}) and n_batch ({}) must all be at least 1",
-                    config.threads, config.n_ctx, config.n_batch
+                    "threads ({}), n_ctx ({}), n_batch ({}) and n_slots ({}) must all be at least 1",
+                    config.threads, config.n_ctx, config.n_batch, config.n_slots
+                ),
+            });
+        }
+        if config.n_slots > MAX_SLOTS {
+            return Err(LlmError::Config {
+                message: format!(
+                    "n_slots ({}) exceeds llama.cpp's limit of {MAX_SLOTS} sequences",
+                    config.n_slots
                 ),
             });
         }
@@ -341,8 +362,12 @@ fn worker_main(cfg: LlamaCppConfig, ready: SyncSender<Result<(), LlmError>>, rx:
         }
     };
     let threads = i32::try_from(cfg.threads).unwrap_or(i32::MAX);
+    // One unified KV buffer shared by all slots: every slot can use the whole n_ctx (a
+    // non-unified cache would split it into n_ctx / n_slots per sequence).
     let params = LlamaContextParams::default()
         .with_n_ctx(NonZeroU32::new(cfg.n_ctx))
+        .with_n_seq_max(cfg.n_slots)
+        .with_kv_unified(true)
         .with_n_batch(cfg.n_batch)
         .with_n_ubatch(cfg.n_batch)
         .with_n_threads(threads)
@@ -360,11 +385,13 @@ fn worker_main(cfg: LlamaCppConfig, ready: SyncSender<Result<(), LlmError>>, rx:
             return;
         }
     };
+    let n_slots = if cfg.prefix_cache { cfg.n_slots } else { 1 };
     let mut worker = Worker {
         model: &model,
         ctx,
         template,
-        cached: Vec::new(),
+        slots: (0..n_slots).map(|_| Slot::default()).collect(),
+        clock: 0,
         cfg: &cfg,
     };
     if ready.send(Ok(())).is_err() {
@@ -382,13 +409,58 @@ fn worker_main(cfg: LlamaCppConfig, ready: SyncSender<Result<(), LlmError>>, rx:
     }
 }
 
+/// One llama.cpp sequence of the KV cache.
+#[derive(Default)]
+struct Slot {
+    /// The tokens whose keys/values are in the KV cache for this sequence, in position order.
+    tokens: Vec<LlamaToken>,
+    /// `Worker::clock` when a request last used it (0: never).
+    last_used: u64,
+}
+
 struct Worker<'m> {
     model: &'m LlamaModel,
     ctx: LlamaContext<'m>,
     template: LlamaChatTemplate,
-    /// The tokens whose keys/values are in the KV cache (sequence 0), in position order.
-    cached: Vec<LlamaToken>,
+    /// Slot `i` is llama.cpp sequence id `i`.
+    slots: Vec<Slot>,
+    /// Counts requests, for least-recently-used choices.
+    clock: u64,
     cfg: &'m LlamaCppConfig,
+}
+
+/// The slot for a prompt and the length of the prefix it already holds: the slot with the
+/// longest common prefix, if that prefix is worth keeping (at least half of the slot's
+/// tokens or half of the prompt); otherwise the least recently used slot, so that a prompt
+/// with a different prefix does not overwrite a useful one. Ties go to the least recently
+/// used slot.
+fn choose_slot(slots: &[Slot], tokens: &[LlamaToken]) -> (usize, usize) {
+    let lcp = |s: &Slot| {
+        s.tokens
+            .iter()
+            .zip(tokens)
+            .take_while(|(a, b)| a == b)
+            .count()
+    };
+    let lru = slots
+        .iter()
+        .enumerate()
+        .min_by_key(|(_, s)| s.last_used)
+        .map_or(0, |(i, _)| i);
+    let best = slots
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (i, lcp(s)))
+        .max_by(|(i, a), (j, b)| {
+            a.cmp(b)
+                .then_with(|| slots[*j].last_used.cmp(&slots[*i].last_used))
+        });
+    match best {
+        Some((i, n)) if n > 0 && (2 * n >= slots[i].tokens.len() || 2 * n >= tokens.len()) => {
+            (i, n)
+        }
+        _ => (lru, slots.get(lru).map_or(0, lcp)),
+    }
 }
 
 impl Worker<'_> {
@@ -428,7 +500,23 @@ impl Worker<'_> {
 
     fn reset_cache(&mut self) {
         self.ctx.clear_kv_cache();
-        self.cached.clear();
+        for s in &mut self.slots {
+            s.tokens.clear();
+        }
+    }
+
+    /// Empties slot `i` (its whole sequence); empties every slot if llama.cpp refuses.
+    fn clear_slot(&mut self, i: usize) {
+        let cleared = u32::try_from(i)
+            .ok()
+            .and_then(|seq| self.ctx.clear_kv_cache_seq(Some(seq), None, None).ok());
+        if cleared == Some(true) {
+            if let Some(s) = self.slots.get_mut(i) {
+                s.tokens.clear();
+            }
+        } else {
+            self.reset_cache();
+        }
     }
 
     fn decode(&mut self, batch: &mut LlamaBatch<'_>) -> Result<(), LlmError> {
@@ -464,28 +552,62 @@ impl Worker<'_> {
         // Build the sampler first: a bad grammar fails before the cache is touched.
         let mut sampler = self.sampler(req)?;
 
-        // Keep the longest common prefix of the cache; always evaluate at least one token so
-        // that there are fresh logits to sample from.
-        let mut keep = if self.cfg.prefix_cache {
-            self.cached
-                .iter()
-                .zip(&tokens)
-                .take_while(|(a, b)| a == b)
-                .count()
+        let max_new = (req.max_tokens as usize).min(n_ctx - tokens.len());
+
+        // Pick the slot holding the longest useful common prefix and keep that prefix;
+        // always evaluate at least one token so that there are fresh logits to sample from.
+        self.clock += 1;
+        let (slot, common) = if self.cfg.prefix_cache {
+            choose_slot(&self.slots, &tokens)
         } else {
-            0
+            (0, 0)
         };
-        keep = keep.min(tokens.len() - 1);
-        if keep < self.cached.len() {
-            let removed = u32::try_from(keep)
-                .ok()
-                .and_then(|p0| self.ctx.clear_kv_cache_seq(Some(0), Some(p0), None).ok());
+        let seq = i32::try_from(slot).map_err(|_| LlmError::Decode {
+            message: format!("slot {slot} does not fit llama.cpp's sequence ids"),
+        })?;
+        let mut keep = common.min(tokens.len() - 1);
+        let held = self.slots.get(slot).map_or(0, |s| s.tokens.len());
+        if keep < held {
+            let removed = u32::try_from(keep).ok().and_then(|p0| {
+                self.ctx
+                    .clear_kv_cache_seq(Some(seq.unsigned_abs()), Some(p0), None)
+                    .ok()
+            });
             if removed != Some(true) {
                 // Some memory types (recurrent models) cannot drop a suffix: start over.
-                self.reset_cache();
+                self.clear_slot(slot);
                 keep = 0;
             }
-            self.cached.truncate(keep);
+        }
+        if let Some(s) = self.slots.get_mut(slot) {
+            s.tokens.truncate(keep);
+            s.last_used = self.clock;
+        }
+        // The slots share one KV buffer of n_ctx cells: make room for the rest of the prompt
+        // and the longest answer by emptying least recently used slots.
+        let need = tokens.len() - keep + max_new;
+        loop {
+            let used: usize = self.slots.iter().map(|s| s.tokens.len()).sum();
+            if used + need <= n_ctx {
+                break;
+            }
+            let victim = self
+                .slots
+                .iter()
+                .enumerate()
+                .filter(|(i, s)| *i != slot && !s.tokens.is_empty())
+                .min_by_key(|(_, s)| s.last_used)
+                .map(|(i, _)| i);
+            match victim {
+                Some(v) => self.clear_slot(v),
+                // Cannot happen (the slot holds only `keep` prompt tokens and the prompt plus
+                // answer fit n_ctx), but never loop forever.
+                None => break,
+            }
+        }
+        // `clear_slot` may have fallen back to emptying everything.
+        if self.slots.get(slot).map_or(0, |s| s.tokens.len()) < keep {
+            keep = 0;
         }
 
         let t_prompt = Instant::now();
@@ -497,16 +619,17 @@ impl Worker<'_> {
             let base = keep + ci * n_batch;
             for (j, &tok) in chunk.iter().enumerate() {
                 let pos = base + j;
-                add(&mut batch, tok, pos, pos + 1 == tokens.len())?;
+                add(&mut batch, tok, pos, seq, pos + 1 == tokens.len())?;
             }
             self.decode(&mut batch)?;
-            self.cached.extend_from_slice(chunk);
+            if let Some(s) = self.slots.get_mut(slot) {
+                s.tokens.extend_from_slice(chunk);
+            }
             last_idx = batch.n_tokens() - 1;
         }
         let prompt_ms = t_prompt.elapsed().as_secs_f64() * 1e3;
 
         let t_gen = Instant::now();
-        let max_new = (req.max_tokens as usize).min(n_ctx - tokens.len());
         let max_stop = req.stop.iter().map(String::len).max().unwrap_or(0);
         let mut out: Vec<u8> = Vec::new();
         let mut n_gen = 0usize;
@@ -532,9 +655,11 @@ impl Worker<'_> {
                 break FinishReason::Length;
             }
             batch.clear();
-            add(&mut batch, tok, pos, true)?;
+            add(&mut batch, tok, pos, seq, true)?;
             self.decode(&mut batch)?;
-            self.cached.push(tok);
+            if let Some(s) = self.slots.get_mut(slot) {
+                s.tokens.push(tok);
+            }
             pos += 1;
             last_idx = 0;
         };
@@ -559,13 +684,14 @@ fn add(
     batch: &mut LlamaBatch<'_>,
     tok: LlamaToken,
     pos: usize,
+    seq: i32,
     logits: bool,
 ) -> Result<(), LlmError> {
     let pos = i32::try_from(pos).map_err(|_| LlmError::Decode {
         message: format!("position {pos} does not fit llama.cpp's i32"),
     })?;
     batch
-        .add(tok, pos, &[0], logits)
+        .add(tok, pos, &[seq], logits)
         .map_err(|e| LlmError::Decode {
             message: format!("cannot add a token to the batch: {e}"),
         })
@@ -599,6 +725,35 @@ mod tests {
         let out = b"let x = 1;\n```\n";
         assert_eq!(find_stop(out, 13, 3, &stops), Some(11));
         assert_eq!(find_stop(b"xEND", 1, 3, &stops), Some(1));
+    }
+
+    fn slot(tokens: &[i32], last_used: u64) -> Slot {
+        Slot {
+            tokens: tokens.iter().map(|&t| LlamaToken::new(t)).collect(),
+            last_used,
+        }
+    }
+
+    #[test]
+    fn slot_choice_prefers_long_prefixes_then_least_recently_used() {
+        let toks = |v: &[i32]| v.iter().map(|&t| LlamaToken::new(t)).collect::<Vec<_>>();
+        let slots = vec![
+            slot(&[1, 2, 3, 4, 5, 6], 3),
+            slot(&[1, 9, 9, 9, 9, 9], 2),
+            slot(&[], 0),
+        ];
+        // Longest common prefix wins.
+        assert_eq!(choose_slot(&slots, &toks(&[1, 2, 3, 4, 7])), (0, 4));
+        // A one-token header in common is not worth overwriting slot 1: the empty slot.
+        assert_eq!(choose_slot(&slots, &toks(&[1, 8, 8, 8, 8, 8])), (2, 0));
+        // Nothing in common: the least recently used slot (the empty one).
+        assert_eq!(choose_slot(&slots, &toks(&[5, 5])), (2, 0));
+        // No empty slot: least recently used is slot 1.
+        let full = vec![slot(&[1, 2, 3], 5), slot(&[4, 5], 1), slot(&[6], 3)];
+        assert_eq!(choose_slot(&full, &toks(&[7, 7])), (1, 0));
+        // Equal prefixes: the least recently used of them.
+        let tie = vec![slot(&[1, 2], 5), slot(&[1, 2], 4)];
+        assert_eq!(choose_slot(&tie, &toks(&[1, 2, 3])), (1, 2));
     }
 
     #[test]
