@@ -1,0 +1,170 @@
+//! The pipeline end to end: a real model (SmolLM2-135M GGUF) and a cassette recorded from it.
+//!
+//! Re-record the cassette after changing prompts:
+//! `IVLMAP_RECORD=1 cargo test -p agent --release --test language_e2e -- --nocapture`
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use agent::{
+    check_script, plan_instruction, CassetteRecord, LanguageError, LlamaCppBackend, LlamaCppConfig,
+    LlmBackend, Outcome, PlanContext, PlanSource, Prompts, Recording, ReplayBackend, Role,
+};
+use map_core::{IvlMap, Robot, Scene, SimRobot};
+use planner_dsl::{Limits, Plan};
+
+const INSTRUCTION: &str = "go to the second black chair and then face the tv";
+
+fn flat_a() -> Arc<IvlMap> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../examples/scenes/flat-a.scene.json"
+    );
+    Arc::new(IvlMap::from_scene(&Scene::from_path(path).unwrap()))
+}
+
+fn cassette() -> PathBuf {
+    PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/language_cassettes/smollm2_plan.jsonl"
+    ))
+}
+
+fn smol_path() -> Option<PathBuf> {
+    let dir = std::env::var_os("IVLMAP_MODELS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            PathBuf::from(std::env::var_os("HOME").unwrap_or_default()).join(".cache/ivlmap/models")
+        });
+    let p = dir.join("SmolLM2-135M-Instruct.Q4_1.gguf");
+    if p.is_file() {
+        Some(p)
+    } else {
+        eprintln!(
+            "SKIPPED: {} is absent; run scripts/fetch-models.sh",
+            p.display()
+        );
+        None
+    }
+}
+
+/// The LLM path is forced (no template) so that step 2 and the repair loop run.
+fn ctx<'a>(map: &'a IvlMap, robot: &'a SimRobot) -> PlanContext<'a> {
+    let mut c = PlanContext::new(map).with_robot(robot);
+    c.options.deterministic = false;
+    c.options.plan_max_tokens = 160;
+    c
+}
+
+/// Whatever the model did, the result is either a plan that validates, agrees with the
+/// tuples and the map, and runs; or a clear error/question. Returns a short label.
+fn judge(res: &Result<Outcome, LanguageError>, map: &Arc<IvlMap>) -> String {
+    match res {
+        Ok(Outcome::Plan(p)) => {
+            let plan = Plan::compile(&p.script).expect("a returned plan validates");
+            assert!(check_script(&p.script, &p.tuples, Some(map))
+                .unwrap()
+                .is_empty());
+            let mut robot = SimRobot::new(map.clone());
+            let out = planner_dsl::run(&plan, map, &mut robot, &Limits::default());
+            assert!(out.error.is_none(), "{:?}", out.error);
+            assert!(matches!(p.source, PlanSource::Llm { .. }));
+            assert_eq!(p.attempts.len() as u32, p.timing.llm_calls - 1);
+            format!("plan after {} attempt(s): {}", p.attempts.len(), p.script)
+        }
+        Ok(Outcome::Question(q)) => {
+            assert!(q.ends_with('?'), "{q}");
+            format!("question: {q}")
+        }
+        Ok(Outcome::Refusal(r)) => {
+            assert!(r.contains("map has no"), "{r}");
+            format!("refusal: {r}")
+        }
+        Err(LanguageError::InvalidPlan {
+            attempts, errors, ..
+        }) => {
+            assert_eq!(*attempts, 3, "1 try + 2 repairs");
+            assert!(!errors.is_empty());
+            format!("invalid after {attempts}: {errors:?}")
+        }
+        Err(LanguageError::Tuples { answer, .. }) => format!("unreadable tuples: {answer:?}"),
+        Err(e) => panic!("unexpected error: {e}"),
+    }
+}
+
+#[test]
+fn smollm2_instruction_in_checked_plan_or_clear_error_out() {
+    let Some(model) = smol_path() else { return };
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let mut cfg = LlamaCppConfig::new(model);
+    cfg.n_ctx = 4096;
+    let llama = LlamaCppBackend::new(cfg).unwrap();
+    let backend: Box<dyn LlmBackend> = if std::env::var_os("IVLMAP_RECORD").is_some() {
+        let _ = std::fs::remove_file(cassette());
+        Box::new(Recording::new(llama, cassette()).unwrap())
+    } else {
+        Box::new(llama)
+    };
+    let res = plan_instruction(
+        backend.as_ref(),
+        &Prompts::builtin(),
+        INSTRUCTION,
+        &ctx(&map, &robot),
+    );
+    println!("{}", judge(&res, &map));
+    assert_eq!(
+        robot.trajectory().stops.len(),
+        0,
+        "planning never moves the robot"
+    );
+}
+
+#[test]
+fn repair_loop_replays_from_a_recorded_cassette() {
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let replay = ReplayBackend::open(cassette()).unwrap();
+    let records: Vec<CassetteRecord> = std::fs::read_to_string(cassette())
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let res = plan_instruction(
+        &replay,
+        &Prompts::builtin(),
+        INSTRUCTION,
+        &ctx(&map, &robot),
+    );
+    let label = judge(&res, &map);
+    println!("{label}");
+    // Every request after the first plan request is a repair: it replays the model's
+    // answer and quotes positioned problems.
+    for r in records.iter().skip(2) {
+        let msgs = &r.request.messages;
+        let last = msgs.last().unwrap();
+        assert_eq!(last.role, Role::User);
+        assert!(
+            last.content.starts_with("That script cannot be used:"),
+            "{}",
+            last.content
+        );
+        assert!(
+            last.content.contains("line ")
+                || last.content.contains("never uses")
+                || last.content.contains("no script"),
+            "{}",
+            last.content
+        );
+        assert_eq!(msgs[msgs.len() - 2].role, Role::Assistant);
+    }
+    // The outcome matches how many exchanges were recorded.
+    match &res {
+        Ok(Outcome::Plan(p)) => assert_eq!(records.len(), 1 + p.attempts.len()),
+        Err(LanguageError::InvalidPlan { attempts, .. }) => {
+            assert_eq!(records.len() as u32, 1 + attempts)
+        }
+        _ => assert_eq!(records.len(), 1),
+    }
+}
