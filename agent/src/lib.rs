@@ -1,8 +1,21 @@
-//! # agent: the ivlmap language layer (work in progress)
+//! # agent: the ivlmap language layer
 //!
-//! LLM backends: [`LlmBackend`] with [`LlamaCppBackend`] (local GGUF via llama.cpp),
-//! [`OpenAiBackend`] (any OpenAI-compatible server) and [`ReplayBackend`] / [`Recording`]
-//! (cassettes).
+//! Turns an instruction into (object, ordinal, colour) tuples and a checked Rhai plan.
+//!
+//! - LLM backends behind [`LlmBackend`]: [`LlamaCppBackend`] (any local GGUF through
+//!   llama.cpp, with a multi-slot prefix cache and GBNF grammars), [`OpenAiBackend`]
+//!   (any OpenAI-compatible server) and [`ReplayBackend`] / [`Recording`] (cassettes).
+//! - The language layer: [`Prompts`] (templates in `prompts/`, variants as folders),
+//!   [`extract_tuples`], [`plan_instruction`] (validation with planner_dsl, checks
+//!   against the tuples and the map, a bounded repair loop) and chat [`Session`]s.
+//! - Evaluation of extraction and navigation suites, and the `ivlmap` binary's parts.
+//!
+//! ```
+//! // The paper's tuple form and JSON both parse; ordinals and colours are normalised.
+//! let t = agent::parse_tuples("[(tables, third, Yellow), (sofa, last, none)]").unwrap();
+//! assert_eq!((t[0].object.as_str(), t[0].ordinal, t[0].colour.as_deref()), ("table", Some(3), Some("yellow")));
+//! assert_eq!((t[1].ordinal, t[1].colour.as_deref()), (Some(-1), None));
+//! ```
 
 mod backend;
 mod cli;
