@@ -55,16 +55,7 @@ pub struct JsonLocation {
 
 impl fmt::Display for JsonLocation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if let Some(l) = self.line {
-            write!(f, ":{l}")?;
-            if let Some(c) = self.column {
-                write!(f, ":{c}")?;
-            }
-        }
-        if !self.field.is_empty() && self.field != "." {
-            write!(f, ": field `{}`", self.field)?;
-        }
-        Ok(())
+        crate::scene::write_position(f, self.line, self.column, &self.field)
     }
 }
 

@@ -246,17 +246,28 @@ pub struct SceneLocation {
 impl fmt::Display for SceneLocation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", self.file.display())?;
-        if let Some(l) = self.line {
-            write!(f, ":{l}")?;
-            if let Some(c) = self.column {
-                write!(f, ":{c}")?;
-            }
-        }
-        if !self.field.is_empty() && self.field != "." {
-            write!(f, ": field `{}`", self.field)?;
-        }
-        Ok(())
+        write_position(f, self.line, self.column, &self.field)
     }
+}
+
+/// `:line:column: field `path`` (each part only where known), shared by the scene
+/// and saved-map readers.
+pub(crate) fn write_position(
+    f: &mut fmt::Formatter<'_>,
+    line: Option<usize>,
+    column: Option<usize>,
+    field: &str,
+) -> fmt::Result {
+    if let Some(l) = line {
+        write!(f, ":{l}")?;
+        if let Some(c) = column {
+            write!(f, ":{c}")?;
+        }
+    }
+    if !field.is_empty() && field != "." {
+        write!(f, ": field `{field}`")?;
+    }
+    Ok(())
 }
 
 /// A scene that could not be read.
