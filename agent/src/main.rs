@@ -86,22 +86,8 @@ enum Command {
         /// Backend(s); several give a side-by-side table.
         #[arg(long = "backend", value_name = "B", default_value = "llama")]
         backends: Vec<String>,
-        /// llama: GGUF file (default ~/.cache/ivlmap/models/qwen2.5-coder-1.5b-instruct-q4_k_m.gguf,
-        /// IVLMAP_MODELS overrides the folder); openai: model id.
-        #[arg(long)]
-        model: Option<String>,
-        /// openai: server base URL (else IVLMAP_BASE_URL).
-        #[arg(long)]
-        base_url: Option<String>,
-        /// replay: the cassette to answer from.
-        #[arg(long)]
-        cassette: Option<PathBuf>,
-        /// Record every request and answer to this cassette.
-        #[arg(long)]
-        record: Option<PathBuf>,
-        /// llama: CPU threads.
-        #[arg(long)]
-        threads: Option<u32>,
+        #[command(flatten)]
+        model_args: ModelArgs,
         /// Prompt variant folder(s); several give a side-by-side table (default: built-in).
         #[arg(long = "prompts", value_name = "DIR")]
         prompts: Vec<PathBuf>,
@@ -161,6 +147,19 @@ struct BackendArgs {
     /// LLM backend: llama (local GGUF), openai (OpenAI-compatible server), replay (cassette).
     #[arg(long, default_value = "llama")]
     backend: String,
+    #[command(flatten)]
+    model_args: ModelArgs,
+}
+
+impl BackendArgs {
+    fn choice(&self) -> BackendChoice {
+        self.model_args.choice(&self.backend)
+    }
+}
+
+/// Backend settings shared by every command that talks to a model.
+#[derive(Debug, Args)]
+struct ModelArgs {
     /// llama: GGUF file (default ~/.cache/ivlmap/models/qwen2.5-coder-1.5b-instruct-q4_k_m.gguf,
     /// IVLMAP_MODELS overrides the folder); openai: model id.
     #[arg(long)]
@@ -179,10 +178,10 @@ struct BackendArgs {
     threads: Option<u32>,
 }
 
-impl BackendArgs {
-    fn choice(&self) -> BackendChoice {
+impl ModelArgs {
+    fn choice(&self, backend: &str) -> BackendChoice {
         BackendChoice {
-            name: self.backend.clone(),
+            name: backend.to_string(),
             model: self.model.clone(),
             base_url: self.base_url.clone(),
             cassette: self.cassette.clone(),
@@ -265,26 +264,13 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
         Command::Eval {
             suite,
             backends,
-            model,
-            base_url,
-            cassette,
-            record,
-            threads,
+            model_args,
             prompts: p,
             report,
             baseline,
         } => {
-            let choices: Vec<BackendChoice> = backends
-                .iter()
-                .map(|b| BackendChoice {
-                    name: b.clone(),
-                    model: model.clone(),
-                    base_url: base_url.clone(),
-                    cassette: cassette.clone(),
-                    record: record.clone(),
-                    threads,
-                })
-                .collect();
+            let choices: Vec<BackendChoice> =
+                backends.iter().map(|b| model_args.choice(b)).collect();
             eval(&suite, &choices, &p, &report, baseline)
         }
         Command::Map { command } => map_cmd(command),
