@@ -74,6 +74,21 @@ impl Walker<'_> {
         });
     }
 
+    /// Report `name` if it is on the forbidden list (eval, sleep, print...); true if it was.
+    fn push_if_forbidden(&mut self, pos: rhai::Position, name: &str) -> bool {
+        let Some(reason) = forbidden(name) else {
+            return false;
+        };
+        self.push(
+            pos,
+            ViolationKind::Forbidden {
+                name: name.to_string(),
+                reason: reason.to_string(),
+            },
+        );
+        true
+    }
+
     fn library_call(&mut self, x: &FnCallExpr, pos: rhai::Position) -> bool {
         let Some(spec) = lookup(x.name.as_str()) else {
             return false;
@@ -132,14 +147,7 @@ impl Walker<'_> {
             // A capturing closure; reported once, at the closure.
             return;
         }
-        if let Some(reason) = forbidden(name) {
-            self.push(
-                pos,
-                ViolationKind::Forbidden {
-                    name: name.to_string(),
-                    reason: reason.to_string(),
-                },
-            );
+        if self.push_if_forbidden(pos, name) {
             return;
         }
         self.push(
@@ -190,14 +198,7 @@ impl Walker<'_> {
             );
             return;
         }
-        if let Some(reason) = forbidden(name) {
-            self.push(
-                pos,
-                ViolationKind::Forbidden {
-                    name: name.to_string(),
-                    reason: reason.to_string(),
-                },
-            );
+        if self.push_if_forbidden(pos, name) {
             return;
         }
         self.push(
