@@ -17,6 +17,7 @@
 //! assert_eq!((cell.row, cell.col), (0, 0)); // north-west corner
 //! ```
 
+mod embed;
 mod geometry;
 mod goals;
 mod grid;
@@ -31,6 +32,11 @@ mod render;
 mod robot;
 mod scene;
 
+pub use crate::embed::{
+    label_cells, models_dir, ort_library_path, CellLabels, EmbedError, EmbeddingMatcher,
+    Embeddings, FeatureMap, TextEncoder, TextEncoderOptions, DEFAULT_EMBEDDING_THRESHOLD,
+    MINILM_MODEL_FILE, MINILM_TOKENIZER_FILE, MODELS_ENV, ORT_LIB_ENV, ORT_LIB_FILE,
+};
 pub use crate::geometry::{
     closest_on_segment, normalize_heading, oriented_rect, Aabb, Point, Polygon, Pose,
 };

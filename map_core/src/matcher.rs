@@ -16,14 +16,19 @@ pub trait NameMatcher: Debug + Send + Sync {
 
     /// The best-scoring label at or above the threshold (ties: first in `labels`).
     fn best<'a>(&self, query: &str, labels: &[&'a str]) -> Option<&'a str> {
-        let mut best: Option<(f32, &'a str)> = None;
+        self.best_scored(query, labels).map(|(l, _)| l)
+    }
+
+    /// [`NameMatcher::best`] with its score.
+    fn best_scored<'a>(&self, query: &str, labels: &[&'a str]) -> Option<(&'a str, f32)> {
+        let mut best: Option<(&'a str, f32)> = None;
         for &l in labels {
             let s = self.score(query, l);
-            if s >= self.threshold() && best.is_none_or(|(b, _)| s > b) {
-                best = Some((s, l));
+            if s >= self.threshold() && best.is_none_or(|(_, b)| s > b) {
+                best = Some((l, s));
             }
         }
-        best.map(|(_, l)| l)
+        best
     }
 }
 
