@@ -28,6 +28,7 @@ mod perception;
 mod persist;
 mod planner;
 mod query;
+mod reconstruct;
 mod render;
 mod robot;
 mod scene;
@@ -65,6 +66,16 @@ pub use crate::planner::{
     GridPlanner, Passability, PlanError, WorldPath,
 };
 pub use crate::query::{ordinal_word, ObjectOrder, QueryError};
+pub use crate::reconstruct::{
+    base_from_pose2d, import_vlmaps_legacy, map_frame, parse_poses_txt, pose2d_from_base,
+    read_depth, read_poses_txt, read_rgb_png, reconstruct, reconstruct_with_progress,
+    render_rgbd, vlmaps_grid_frame, world_poses, write_depth_npy, write_depth_png,
+    write_poses_txt, write_rgb_png, write_vlmaps_legacy, Anchor, CameraInfo, FeatureGrid,
+    FrameFiles, FramePose, Intrinsics, MapSpec, PoseConvention, ReconstructError,
+    ReconstructOptions, RgbdDataset, RgbdFrame, RgbdRenderer, SyntheticOptions, TopDownBuilder,
+    TopDownMaps, VlmapsCrop, VlmapsImportOptions, VlmapsLegacyMap, VlmapsWindow, WorldPoses,
+    DEFAULT_OBJECT_HEIGHT, RGBD_FORMAT,
+};
 pub use crate::render::{
     auto_scale, colour_rgb, render_png, render_rgb, render_trajectory_png, RenderError,
     RenderOptions, RenderOverlay, FINAL_RGB, MAX_SIDE_PX, PALETTE, PATH_RGB, START_RGB, STOP_RGB,
