@@ -55,10 +55,10 @@ pub use crate::npy::{read_npy, read_npy_from, write_npy, write_npy_to, NpyElemen
 pub use crate::perception::{
     ciede2000, eq2_scores, label_masks, read_sam_masks, sam_masks_from_str, srgb_to_lab,
     unique_labels, write_sam_masks, write_sam_masks_to, BuildConfig, BuiltMap, ColourClassifier,
-    ColourConfig, ColourEvidence, ColourPalette, ColourVote, DropReason, DroppedMask, KeptMask,
-    LabelConfig, LabelMap, LabelScore, Labelling, Mask, MaskLabel, MaskLocation, PaletteColour,
+    ColourConfig, ColourEvidence, ColourPalette, DropReason, DroppedMask, KeptMask, LabelConfig,
+    LabelMap, LabelScore, Labelling, Mask, MaskColour, MaskLabel, MaskLocation, PaletteColour,
     PerceptionError, PerceptionInputs, Rle, RleError, SamMask, SegmentationForm, BASIC_COLOURS,
-    DEFAULT_ROBOT_RADIUS_M, FLOOR_RGB, MAX_MASK_CELLS, OTHER,
+    BASIC_EXTRA_PROTOTYPES, DEFAULT_ROBOT_RADIUS_M, FLOOR_RGB, MAX_MASK_CELLS, OTHER,
 };
 pub use crate::persist::{JsonLocation, PersistError, MAP_FORMAT};
 pub use crate::planner::{

@@ -10,7 +10,7 @@
 //! `min_area` cells is dropped as [`DropReason::Covered`]; its category (from Eq. 2
 //! on the whole mask) is kept for the visible part.
 
-use super::colour::{ColourClassifier, ColourConfig, ColourVote};
+use super::colour::{ColourClassifier, ColourConfig, MaskColour};
 use super::error::PerceptionError;
 use super::labelling::{
     label_masks, mode_label, DropReason, DroppedMask, LabelConfig, LabelCounter, LabelMap,
@@ -161,7 +161,7 @@ pub struct BuildConfig {
 #[derive(Debug, Clone, PartialEq)]
 pub enum ColourEvidence {
     /// Majority vote over the top-down RGB.
-    Rgb(ColourVote),
+    Rgb(MaskColour),
     /// Most frequent label of the colour label map.
     Labels(LabelScore),
 }

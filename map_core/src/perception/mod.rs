@@ -10,7 +10,7 @@
 //! | write SAM output | [`write_sam_masks`] | [`SamMask`]s -> SAM JSON in a [`SegmentationForm`] |
 //! | masks | [`Mask`], [`Rle`] | row-major runs; COCO RLE encode/decode |
 //! | Eq. 2 | [`label_masks`] with [`LabelConfig`] | [`LabelMap`] + masks -> [`Labelling`] (kept [`MaskLabel`]s, [`DroppedMask`]s with a [`DropReason`]) |
-//! | colour | [`ColourClassifier`] with [`ColourConfig`] / [`ColourPalette`] | RGB pixels of a mask -> [`ColourVote`] |
+//! | colour | [`ColourClassifier`] with [`ColourConfig`] / [`ColourPalette`] | RGB pixels of a mask -> [`MaskColour`] |
 //! | assembly | [`IvlMap::from_perception`] with [`BuildConfig`] | [`PerceptionInputs`] -> [`BuiltMap`] (map + kept + dropped) |
 //! | simulated perception | [`PerceptionInputs::from_scene`] | a scene -> the inputs a perfect perception stack would give |
 //!
@@ -85,8 +85,8 @@ pub use assemble::{
     FLOOR_RGB, OTHER,
 };
 pub use colour::{
-    ciede2000, srgb_to_lab, ColourClassifier, ColourConfig, ColourPalette, ColourVote,
-    PaletteColour, BASIC_COLOURS,
+    ciede2000, srgb_to_lab, ColourClassifier, ColourConfig, ColourPalette, MaskColour,
+    PaletteColour, BASIC_COLOURS, BASIC_EXTRA_PROTOTYPES,
 };
 pub use error::{MaskLocation, PerceptionError};
 pub use labelling::{
