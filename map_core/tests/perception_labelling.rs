@@ -234,12 +234,15 @@ fn label_maps_and_masks_are_checked() {
     assert_eq!(e.to_string(), "mask 1 is 3x2, but the map frame is 2x3");
 }
 
+/// (label, score, top k (label, count)) of a kept mask.
+type Decision = (u16, f64, Vec<(u16, u64)>);
+
 /// Eq. 2 written the obvious way, cell by cell, as the check.
 fn reference(
     labels: &Grid<u16>,
     m: &Mask,
     cfg: &LabelConfig,
-) -> Result<(u16, f64, Vec<(u16, u64)>), &'static str> {
+) -> Result<Decision, &'static str> {
     let mut counts: BTreeMap<u16, u64> = BTreeMap::new();
     let mut area = 0u64;
     for r in 0..labels.rows() {
