@@ -134,6 +134,11 @@ fn a_known_cell_lands_where_vlmaps_put_it() {
     }
     assert_eq!(m.obstacles.as_slice().iter().filter(|&&o| o).count(), 2);
     assert_eq!(m.features.as_ref().unwrap().shape(), [23, 22, DIM]);
+    // the embedding layer takes the features as they are
+    let fm = m.features.clone().unwrap().into_feature_map().unwrap();
+    assert_eq!((fm.rows(), fm.cols(), fm.dim()), (23, 22, DIM));
+    let c = m.frame.cell_at(vlmaps_cell_centre(OCC.0, OCC.1)).unwrap();
+    assert_eq!(fm.cell(c.row, c.col), m.features.as_ref().unwrap().cell(c));
     // north-east of the origin the frame is VLMaps' pos2grid_id exactly
     let p = Point::new(0.26, 0.41); // right 0.26, forward 0.41
     let full = vlmaps_grid_frame(GS, GS, CS).cell_at(p).unwrap();

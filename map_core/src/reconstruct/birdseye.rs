@@ -246,7 +246,8 @@ impl TopDownBuilder {
                     continue;
                 };
                 let i = m.hits.index(cell);
-                m.hits.as_mut_slice()[i] += 1;
+                let hits = &mut m.hits.as_mut_slice()[i];
+                *hits = hits.saturating_add(1);
                 m.points += 1;
                 let zf = z as f32;
                 let top = m.height.as_slice()[i];
@@ -257,7 +258,8 @@ impl TopDownBuilder {
                     }
                 }
                 if z >= self.floor_margin {
-                    m.obstacle_hits.as_mut_slice()[i] += 1;
+                    let n = &mut m.obstacle_hits.as_mut_slice()[i];
+                    *n = n.saturating_add(1);
                 }
             }
         }
@@ -307,13 +309,10 @@ pub fn map_frame(
         }
     };
     if frame.rows.saturating_mul(frame.cols) > MAX_CELLS {
-        return Err(ReconstructError::Dataset {
-            path: Default::default(),
-            message: format!(
-                "the map would have {} x {} cells (limit {MAX_CELLS}); give map bounds or a larger cell size",
-                frame.rows, frame.cols
-            ),
-        });
+        return Err(ReconstructError::Options(format!(
+            "the map would have {} x {} cells (limit {MAX_CELLS}); give map bounds or a larger cell size",
+            frame.rows, frame.cols
+        )));
     }
     Ok(frame)
 }
@@ -359,7 +358,7 @@ pub fn reconstruct_with_progress(
         .map(|f| [f.camera.translation.x, f.camera.translation.y])
         .collect();
     let frame = map_frame(&spec, &positions, opts.max_depth).map_err(|e| match e {
-        ReconstructError::Dataset { message, .. } => ReconstructError::Dataset {
+        ReconstructError::Options(message) => ReconstructError::Dataset {
             path: dataset.root.clone(),
             message,
         },

@@ -28,6 +28,7 @@ use super::birdseye::{crop, TopDownMaps};
 use super::camera::vlmaps_grid_frame;
 use super::ndnpy::{self, shape_str, NdArray, NdData};
 use super::ReconstructError;
+use crate::embed::{EmbedError, FeatureMap};
 use crate::geometry::Point;
 use crate::grid::{Cell, Grid, GridFrame};
 
@@ -100,6 +101,12 @@ impl FeatureGrid {
     /// `[rows, cols, dim]`.
     pub fn shape(&self) -> [usize; 3] {
         [self.rows, self.cols, self.dim]
+    }
+
+    /// The same values as the embedding layer's [`FeatureMap`] (same row-major,
+    /// cell-by-cell layout), ready for [`label_cells`](crate::label_cells).
+    pub fn into_feature_map(self) -> Result<FeatureMap, EmbedError> {
+        FeatureMap::new(self.rows, self.cols, self.dim, self.data)
     }
 }
 
