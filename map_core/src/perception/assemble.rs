@@ -354,15 +354,20 @@ impl IvlMap {
         assign_label_ids(&mut instances);
 
         // Layers from the owner grid.
-        let slot: std::collections::HashMap<u32, usize> =
-            visible.iter().enumerate().map(|(n, v)| (v.1, n)).collect();
+        // instance id (mask index + 1) -> position in `visible`
+        let mut slot = vec![usize::MAX; inputs.masks.len() + 1];
+        for (n, v) in visible.iter().enumerate() {
+            if let Some(x) = slot.get_mut(v.1 as usize) {
+                *x = n;
+            }
+        }
         let mut category = Grid::new(frame.rows, frame.cols, 0u16);
         let mut colour = Grid::new(frame.rows, frame.cols, 0u8);
         for (i, &o) in owner.iter().enumerate() {
             if o == 0 {
                 continue;
             }
-            if let Some(&n) = slot.get(&o) {
+            if let Some(&n) = slot.get(o as usize).filter(|&&n| n != usize::MAX) {
                 if let Some(c) = category.as_mut_slice().get_mut(i) {
                     *c = cat_of[n];
                 }
