@@ -165,3 +165,109 @@ fn feature_map_labelled_with_encoded_categories() {
     }
     assert_eq!(out.scores.as_slice()[3], 0.0);
 }
+
+/// Protocol-buffer writer, just enough for a hand-made ONNX model.
+fn varint(out: &mut Vec<u8>, mut v: u64) {
+    while v >= 0x80 {
+        out.push((v as u8) | 0x80);
+        v >>= 7;
+    }
+    out.push(v as u8);
+}
+fn field_int(out: &mut Vec<u8>, field: u64, v: u64) {
+    varint(out, field << 3);
+    varint(out, v);
+}
+fn field_bytes(out: &mut Vec<u8>, field: u64, bytes: &[u8]) {
+    varint(out, (field << 3) | 2);
+    varint(out, bytes.len() as u64);
+    out.extend_from_slice(bytes);
+}
+
+/// ValueInfoProto: a tensor of `elem_type` with dims ("batch" symbolic, numbers fixed).
+fn value_info(name: &str, elem_type: u64, dims: &[Result<u64, &str>]) -> Vec<u8> {
+    let mut shape = Vec::new();
+    for d in dims {
+        let mut dim = Vec::new();
+        match d {
+            Ok(n) => field_int(&mut dim, 1, *n),
+            Err(p) => field_bytes(&mut dim, 2, p.as_bytes()),
+        }
+        field_bytes(&mut shape, 1, &dim);
+    }
+    let mut tensor = Vec::new();
+    field_int(&mut tensor, 1, elem_type);
+    field_bytes(&mut tensor, 2, &shape);
+    let mut ty = Vec::new();
+    field_bytes(&mut ty, 1, &tensor);
+    let mut vi = Vec::new();
+    field_bytes(&mut vi, 1, name.as_bytes());
+    field_bytes(&mut vi, 2, &ty);
+    vi
+}
+
+/// An ONNX model standing in for a CLIP text encoder exported with a fixed context:
+/// one int32 input "tokens" (batch, 8), output "text_embeds" = Cast(tokens, float),
+/// (batch, 8). Its "embedding" is the padded token ids themselves.
+fn fixed_length_model() -> Vec<u8> {
+    const INT32: u64 = 6;
+    const FLOAT: u64 = 1;
+    let mut attr = Vec::new();
+    field_bytes(&mut attr, 1, b"to");
+    field_int(&mut attr, 3, FLOAT);
+    field_int(&mut attr, 20, 2); // AttributeType INT
+    let mut node = Vec::new();
+    field_bytes(&mut node, 1, b"tokens");
+    field_bytes(&mut node, 2, b"text_embeds");
+    field_bytes(&mut node, 4, b"Cast");
+    field_bytes(&mut node, 5, &attr);
+    let mut graph = Vec::new();
+    field_bytes(&mut graph, 1, &node);
+    field_bytes(&mut graph, 2, b"fixed_length_text_encoder");
+    field_bytes(
+        &mut graph,
+        11,
+        &value_info("tokens", INT32, &[Err("batch"), Ok(8)]),
+    );
+    field_bytes(
+        &mut graph,
+        12,
+        &value_info("text_embeds", FLOAT, &[Err("batch"), Ok(8)]),
+    );
+    let mut opset = Vec::new();
+    field_bytes(&mut opset, 1, b"");
+    field_int(&mut opset, 2, 13);
+    let mut model = Vec::new();
+    field_int(&mut model, 1, 8); // ir_version
+    field_bytes(&mut model, 8, &opset);
+    field_bytes(&mut model, 7, &graph);
+    model
+}
+
+#[test]
+fn fixed_length_int32_pooled_encoder_pads_and_truncates() {
+    let (_, tok) = cache_files();
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("fixed.onnx");
+    std::fs::write(&model, fixed_length_model()).unwrap();
+    let enc = TextEncoder::new(&model, &tok, &TextEncoderOptions::default()).unwrap();
+    assert_eq!(enc.dim(), Some(8));
+    let long = "one two three four five six seven eight nine ten";
+    let e = enc.embed(&["sofa", long]).unwrap();
+    assert_eq!((e.len(), e.dim()), (2, 8));
+    let unit = |v: [f32; 8]| {
+        let n = dot(&v, &v).sqrt();
+        v.map(|x| x / n)
+    };
+    // [CLS] sofa [SEP], then padding (id 0) to the model's fixed 8
+    let sofa = unit([101.0, 10682.0, 102.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    for (got, want) in e.row(0).unwrap().iter().zip(&sofa) {
+        assert!((got - want).abs() < 1e-6, "{:?}", e.row(0));
+    }
+    // truncated to 8 tokens by the tokenizer, so still [CLS] ... [SEP]
+    let row = e.row(1).unwrap();
+    let scale = 101.0 / row[0];
+    let ids: Vec<u32> = row.iter().map(|x| (x * scale).round() as u32).collect();
+    assert_eq!((ids[0], ids[7]), (101, 102), "{ids:?}");
+    assert!(ids.iter().all(|&i| i != 0), "{ids:?}");
+}

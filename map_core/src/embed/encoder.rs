@@ -448,6 +448,13 @@ impl TextEncoder {
             .iter()
             .map(|&d| usize::try_from(d).unwrap_or(0))
             .collect();
+        if dims.iter().product::<usize>() != values.len() {
+            return Err(run_err(format!(
+                "output {:?} has shape {dims:?} but {} values",
+                self.output,
+                values.len()
+            )));
+        }
 
         let mut out;
         let dim;
