@@ -32,10 +32,12 @@
 //! ```no_run
 //! use map_core::{EmbeddingMatcher, NameMatcher};
 //! let m = EmbeddingMatcher::minilm(None)?; // loads ORT + MiniLM from the models cache
-//! assert_eq!(m.best("loveseat", &["chair", "sofa", "table"]), Some("sofa"));
-//! assert_eq!(m.best("spaceship", &["chair", "sofa", "table"]), None);
-//! // with the score: Ok(Some(("sofa", cosine)))
-//! let scored = m.try_best("loveseat", &["chair", "sofa", "table"])?;
+//! let labels = ["chair", "fridge", "sofa", "bedside table"];
+//! assert_eq!(m.best("couch", &labels), Some("sofa")); // synonym table, score 1
+//! assert_eq!(m.best("nightstand", &labels), Some("bedside table")); // cosine 0.68
+//! assert_eq!(m.best("spaceship", &labels), None);
+//! // with the score: Some(("fridge", 0.655...))
+//! let scored = m.try_best("freezer", &labels)?;
 //! # Ok::<(), map_core::EmbedError>(())
 //! ```
 //!
