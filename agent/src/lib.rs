@@ -38,9 +38,10 @@ pub use eval::{
     NavScores, NavTask, Report, Subgoal, SuiteError, SuiteKind, Summary, SUCCESS_RADIUS_M,
 };
 pub use language::{
-    check_script, extract_code, extract_tuples, library_calls, normalise_colour, normalise_object,
-    parse_ordinal, parse_tuples, plan_instruction, pythonic_fixups, same_tuples, scene_summary,
-    simple_goto_script, tuples_paper_form, Arg, Finding, FindingKind, LanguageError, LibCall,
-    Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction, Pos, PromptError, Prompts,
-    Session, Timing, Tuple, TupleParseError, Turn, TEMPLATE_NAMES,
+    align_script, check_script, extract_code, extract_tuples, extract_tuples_with, library_calls,
+    normalise_colour, normalise_object, normalise_order, parse_ordinal, parse_ordinal_with_order,
+    parse_tuples, plan_instruction, pythonic_fixups, same_tuples, scene_summary,
+    simple_goto_script, tuple_grammar, tuples_paper_form, Arg, Finding, FindingKind, Fix,
+    LanguageError, LibCall, Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction, Pos,
+    PromptError, Prompts, Session, Timing, Tuple, TupleParseError, Turn, TEMPLATE_NAMES,
 };

@@ -176,6 +176,24 @@ struct ModelArgs {
     /// llama: CPU threads.
     #[arg(long)]
     threads: Option<u32>,
+    /// Grammar-constrained decoding (llama; an openai server gets the grammar only if it
+    /// takes one): `tuples` holds step 1 to the tuple notation, `script` holds step 2 to
+    /// calls of the function library.
+    #[arg(long, value_enum, default_value_t = Grammar::Tuples)]
+    grammar: Grammar,
+}
+
+/// Which steps decode under a GBNF grammar.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Grammar {
+    /// Neither.
+    None,
+    /// Step 1 (tuples).
+    Tuples,
+    /// Step 2 (scripts).
+    Script,
+    /// Both.
+    Both,
 }
 
 impl ModelArgs {
@@ -187,6 +205,14 @@ impl ModelArgs {
             cassette: self.cassette.clone(),
             record: self.record.clone(),
             threads: self.threads,
+        }
+    }
+
+    fn plan_options(&self) -> PlanOptions {
+        PlanOptions {
+            tuple_grammar: matches!(self.grammar, Grammar::Tuples | Grammar::Both),
+            script_grammar: matches!(self.grammar, Grammar::Script | Grammar::Both),
+            ..PlanOptions::default()
         }
     }
 }
@@ -260,6 +286,7 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             json,
             &backend.choice(),
             &prompts(p.as_deref())?,
+            backend.model_args.plan_options(),
         ),
         Command::Eval {
             suite,
@@ -271,7 +298,14 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
         } => {
             let choices: Vec<BackendChoice> =
                 backends.iter().map(|b| model_args.choice(b)).collect();
-            eval(&suite, &choices, &p, &report, baseline)
+            eval(
+                &suite,
+                &choices,
+                &p,
+                &report,
+                baseline,
+                &model_args.plan_options(),
+            )
         }
         Command::Map { command } => map_cmd(command),
     }
@@ -386,11 +420,13 @@ fn plan(
     json: bool,
     choice: &BackendChoice,
     prompts: &Prompts,
+    options: PlanOptions,
 ) -> Result<ExitCode, CliError> {
     let map = load_map(scene)?;
     let backend = open_backend(choice)?;
     let robot = map_core::SimRobot::new(Arc::new(map.clone()));
-    let ctx = PlanContext::new(&map).with_robot(&robot);
+    let mut ctx = PlanContext::new(&map).with_robot(&robot);
+    ctx.options = options;
     let outcome = agent::plan_instruction(backend.as_ref(), prompts, instruction, &ctx)?;
     match outcome {
         Outcome::Plan(p) => {
@@ -446,6 +482,7 @@ fn eval(
     prompt_dirs: &[PathBuf],
     report_path: &Path,
     baseline: Option<Baseline>,
+    plan_options: &PlanOptions,
 ) -> Result<ExitCode, CliError> {
     let kind = SuiteKind::from_path(suite).map_err(CliError::input)?;
     let variants: Vec<(String, Prompts)> = if prompt_dirs.is_empty() {
@@ -507,7 +544,9 @@ fn eval(
             };
             let cases = match kind {
                 SuiteKind::Extract => match &backend {
-                    Some(b) => run_extract(&extract_cases, b.as_ref(), prompts, &mut tick),
+                    Some(b) => {
+                        run_extract(&extract_cases, b.as_ref(), prompts, plan_options, &mut tick)
+                    }
                     None => Vec::new(),
                 },
                 SuiteKind::Nav => run_nav(
@@ -515,7 +554,7 @@ fn eval(
                     method,
                     backend.as_deref().map(|b| b as &dyn LlmBackend),
                     prompts,
-                    &PlanOptions::default(),
+                    plan_options,
                     &mut tick,
                 ),
             };

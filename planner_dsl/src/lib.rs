@@ -69,6 +69,7 @@
 mod engine;
 mod error;
 mod exec;
+mod grammar;
 mod library;
 mod limits;
 mod plan;
@@ -79,6 +80,7 @@ mod value;
 
 pub use crate::error::{PlanError, RuntimeError, RuntimeErrorKind, Span, Violation, ViolationKind};
 pub use crate::exec::{dry_run, run};
+pub use crate::grammar::script_grammar;
 pub use crate::limits::Limits;
 pub use crate::plan::Plan;
 pub use crate::registry::{

@@ -19,7 +19,7 @@ use planner_dsl::{Limits, Plan};
 
 use crate::backend::LlmBackend;
 use crate::language::{
-    extract_tuples, plan_instruction, same_tuples, Outcome, PlanContext, PlanOptions, Prompts,
+    extract_tuples_with, plan_instruction, same_tuples, Outcome, PlanContext, PlanOptions, Prompts,
     Tuple,
 };
 
@@ -58,13 +58,14 @@ pub fn run_extract(
     cases: &[ExtractCase],
     backend: &dyn LlmBackend,
     prompts: &Prompts,
+    options: &PlanOptions,
     on_case: &mut dyn FnMut(&CaseResult),
 ) -> Vec<CaseResult> {
     cases
         .iter()
         .map(|c| {
             let t0 = Instant::now();
-            let r = extract_tuples(backend, prompts, &c.instruction, None);
+            let r = extract_tuples_with(backend, prompts, &c.instruction, None, options);
             let latency_ms = ms(t0);
             let res = match r {
                 Ok((got, _)) => CaseResult {
@@ -124,7 +125,7 @@ fn plan_task(
                     plan: Err(need()),
                 };
             };
-            match extract_tuples(b, prompts, &task.instruction, None) {
+            match extract_tuples_with(b, prompts, &task.instruction, None, options) {
                 Ok((tuples, _)) => Planned {
                     plan: Plan::compile(&vlmap_script(&tuples)).map_err(|e| e.to_string()),
                     tuples: Some(tuples),

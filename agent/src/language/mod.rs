@@ -9,22 +9,26 @@
 //!   loop).
 //! - [`session`]: a chat [`Session`] with history ("go back", "the other one").
 
+mod align;
 mod checks;
+mod grammar;
 mod pipeline;
 mod prompts;
 mod script;
 mod session;
 mod tuples;
 
+pub use align::{align_script, Fix};
 pub use checks::{check_script, library_calls, Arg, Finding, FindingKind, LibCall, Pos};
+pub use grammar::tuple_grammar;
 pub use pipeline::{
-    extract_tuples, plan_instruction, scene_summary, simple_goto_script, LanguageError, Outcome,
-    PlanContext, PlanOptions, PlanSource, PlannedInstruction, Timing,
+    extract_tuples, extract_tuples_with, plan_instruction, scene_summary, simple_goto_script,
+    LanguageError, Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction, Timing,
 };
 pub use prompts::{PromptError, Prompts, TEMPLATE_NAMES};
 pub use script::{extract_code, pythonic_fixups};
 pub use session::{Session, Turn};
 pub use tuples::{
-    normalise_colour, normalise_object, parse_ordinal, parse_tuples, same_tuples,
-    tuples_paper_form, Tuple, TupleParseError,
+    normalise_colour, normalise_object, normalise_order, parse_ordinal, parse_ordinal_with_order,
+    parse_tuples, same_tuples, tuples_paper_form, Tuple, TupleParseError,
 };

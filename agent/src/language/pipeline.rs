@@ -10,6 +10,7 @@ use serde::Serialize;
 
 use crate::backend::{ChatMessage, Completion, CompletionRequest, LlmBackend, LlmError};
 
+use super::align::{align_script, Fix};
 use super::checks::check_script;
 use super::prompts::{PromptError, Prompts};
 use super::script::{extract_code, pythonic_fixups};
@@ -106,6 +107,12 @@ pub struct PlanOptions {
     /// Render the scene summary into step 1's request too (default off: the suite's
     /// expected tuples use the instruction's own words).
     pub scene_in_extract: bool,
+    /// Constrain step 1's answer with [`crate::tuple_grammar`] (backends that take GBNF:
+    /// llama; default on).
+    pub tuple_grammar: bool,
+    /// Constrain step 2's scripts with [`planner_dsl::script_grammar`] (default off: see
+    /// README, "Grammars", for what it costs and changes).
+    pub script_grammar: bool,
 }
 
 impl Default for PlanOptions {
@@ -117,6 +124,8 @@ impl Default for PlanOptions {
             deterministic: true,
             dry_run: true,
             scene_in_extract: false,
+            tuple_grammar: true,
+            script_grammar: false,
         }
     }
 }
@@ -197,6 +206,8 @@ pub struct PlannedInstruction {
     pub timing: Timing,
     /// Every script the LLM wrote, in order (the last is `script` before fixups).
     pub attempts: Vec<String>,
+    /// Object picks rewritten to agree with the tuples (see [`crate::align_script`]).
+    pub fixes: Vec<Fix>,
 }
 
 /// What the language layer makes of an instruction.
@@ -254,7 +265,8 @@ pub fn scene_summary(map: &IvlMap) -> String {
     s
 }
 
-/// Step 1: the (object, ordinal, colour) tuples of `instruction`.
+/// Step 1: the (object, ordinal, colour) tuples of `instruction`, with the default
+/// options (tuple grammar on).
 ///
 /// # Errors
 /// [`LanguageError::Prompt`], [`LanguageError::Backend`], or [`LanguageError::Tuples`] when
@@ -265,28 +277,35 @@ pub fn extract_tuples(
     instruction: &str,
     scene_ctx: Option<&str>,
 ) -> Result<(Vec<Tuple>, Timing), LanguageError> {
-    extract_with(
+    extract_tuples_with(
         backend,
         prompts,
         instruction,
         scene_ctx,
-        PlanOptions::default().extract_max_tokens,
+        &PlanOptions::default(),
     )
 }
 
-fn extract_with(
+/// Step 1 with explicit options (token budget, tuple grammar).
+///
+/// # Errors
+/// As [`extract_tuples`].
+pub fn extract_tuples_with(
     backend: &dyn LlmBackend,
     prompts: &Prompts,
     instruction: &str,
     scene_ctx: Option<&str>,
-    max_tokens: u32,
+    options: &PlanOptions,
 ) -> Result<(Vec<Tuple>, Timing), LanguageError> {
     let t0 = Instant::now();
     let mut req = CompletionRequest::new(
         prompts.extract_messages(instruction, scene_ctx)?,
-        max_tokens,
+        options.extract_max_tokens,
     );
     req.stop = vec!["\nI:".into()];
+    if options.tuple_grammar {
+        req.grammar = Some(super::grammar::tuple_grammar());
+    }
     let c = backend.complete(&req)?;
     let mut timing = Timing::default();
     timing.add(&c);
@@ -304,13 +323,7 @@ fn extract_with(
 fn resolve(tuples: &[Tuple], map: &IvlMap, pose: Pose) -> Option<Outcome> {
     for t in tuples {
         let k = t.ordinal.unwrap_or(0);
-        match map.get_obj_attributes(
-            &t.object,
-            k,
-            t.colour.as_deref(),
-            ObjectOrder::NearToFar,
-            pose,
-        ) {
+        match map.get_obj_attributes(&t.object, k, t.colour.as_deref(), t.object_order(), pose) {
             Ok(_) => {}
             Err(QueryError::UnknownObject { .. }) if map.find_region(&t.object).is_ok() => {}
             Err(e @ QueryError::UnknownObject { .. }) => {
@@ -480,13 +493,14 @@ fn plan_error_messages(src: &str, e: &PlanError) -> Vec<String> {
     }
 }
 
-/// Compiles (with Python-ism fixups when the raw text does not compile), checks agreement
-/// with the tuples and the map, and dry-runs. The plan, or every problem found.
+/// Compiles (with Python-ism fixups when the raw text does not compile), aligns the object
+/// picks with the tuples ([`align_script`]), checks agreement with the tuples and the map,
+/// and dry-runs. The plan and the rewrites made, or every problem found.
 pub(crate) fn assess(
     raw: &str,
     tuples: &[Tuple],
     ctx: &PlanContext<'_>,
-) -> Result<(String, Plan), Vec<String>> {
+) -> Result<(String, Plan, Vec<Fix>), Vec<String>> {
     if raw.trim().is_empty() {
         return Err(vec![
             "no script found: answer with one ```rhai code block that calls the functions".into(),
@@ -501,6 +515,14 @@ pub(crate) fn assess(
                 _ => return Err(plan_error_messages(raw, &e)),
             }
         }
+    };
+    let (src, plan, fixes) = match align_script(&src, tuples, Some(ctx.map)) {
+        (aligned, fixes) if !fixes.is_empty() => match Plan::compile(&aligned) {
+            Ok(p) => (aligned, p, fixes),
+            // Cannot happen for literal rewrites; keep the model's script if it does.
+            Err(_) => (src, plan, Vec::new()),
+        },
+        _ => (src, plan, Vec::new()),
     };
     let findings = check_script(&src, tuples, Some(ctx.map)).map_err(|e| vec![e])?;
     if !findings.is_empty() {
@@ -523,7 +545,7 @@ pub(crate) fn assess(
             }
         }
     }
-    Ok((src, plan))
+    Ok((src, plan, fixes))
 }
 
 /// Plans one instruction: step 1 (tuples), resolution against the map (a question or a
@@ -543,13 +565,8 @@ pub fn plan_instruction(
     let t0 = Instant::now();
     let scene = scene_summary(ctx.map);
     let extract_scene = ctx.options.scene_in_extract.then_some(scene.as_str());
-    let (tuples, t1) = extract_with(
-        backend,
-        prompts,
-        instruction,
-        extract_scene,
-        ctx.options.extract_max_tokens,
-    )?;
+    let (tuples, t1) =
+        extract_tuples_with(backend, prompts, instruction, extract_scene, &ctx.options)?;
     if let Some(o) = resolve(&tuples, ctx.map, ctx.pose()) {
         return Ok(o);
     }
@@ -572,7 +589,8 @@ pub(crate) fn plan_from_tuples(
                 source: PlanSource,
                 timing: Timing,
                 attempts: Vec<String>,
-                tuples: Vec<Tuple>| {
+                tuples: Vec<Tuple>,
+                fixes: Vec<Fix>| {
         let mut timing = timing;
         timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
         Outcome::Plan(Box::new(PlannedInstruction {
@@ -583,11 +601,12 @@ pub(crate) fn plan_from_tuples(
             source,
             timing,
             attempts,
+            fixes,
         }))
     };
     if ctx.options.deterministic {
         if let Some(script) = simple_goto_script(instruction, &tuples, Some(ctx.map)) {
-            if let Ok((src, plan)) = assess(&script, &tuples, ctx) {
+            if let Ok((src, plan, fixes)) = assess(&script, &tuples, ctx) {
                 return Ok(done(
                     src,
                     plan,
@@ -595,6 +614,7 @@ pub(crate) fn plan_from_tuples(
                     timing,
                     Vec::new(),
                     tuples,
+                    fixes,
                 ));
             }
         }
@@ -604,7 +624,10 @@ pub(crate) fn plan_from_tuples(
     let mut attempts = Vec::new();
     let mut last_errors = Vec::new();
     for round in 0..=ctx.options.max_repairs {
-        let req = CompletionRequest::new(messages.clone(), ctx.options.plan_max_tokens);
+        let mut req = CompletionRequest::new(messages.clone(), ctx.options.plan_max_tokens);
+        if ctx.options.script_grammar {
+            req.grammar = Some(planner_dsl::script_grammar());
+        }
         let c = backend.complete(&req)?;
         let mut t = Timing::default();
         t.add(&c);
@@ -612,7 +635,7 @@ pub(crate) fn plan_from_tuples(
         let code = extract_code(&c.text);
         attempts.push(code.clone());
         match assess(&code, &tuples, ctx) {
-            Ok((src, plan)) => {
+            Ok((src, plan, fixes)) => {
                 return Ok(done(
                     src,
                     plan,
@@ -620,6 +643,7 @@ pub(crate) fn plan_from_tuples(
                     timing,
                     attempts,
                     tuples,
+                    fixes,
                 ));
             }
             Err(errors) => {

@@ -168,7 +168,7 @@ impl Session {
         t0: Instant,
     ) -> Result<Outcome, LanguageError> {
         match assess(&script, &tuples, ctx) {
-            Ok((src, plan)) => {
+            Ok((src, plan, fixes)) => {
                 let timing = Timing {
                     wall_ms: t0.elapsed().as_secs_f64() * 1000.0,
                     ..Timing::default()
@@ -181,6 +181,7 @@ impl Session {
                     source: PlanSource::History,
                     timing,
                     attempts: Vec::new(),
+                    fixes,
                 })))
             }
             Err(errors) => Ok(Outcome::Refusal(format!(

@@ -1,5 +1,7 @@
 //! Step 1 answers: `(object, ordinal, colour)` tuples, parsed from whatever the model wrote
-//! and normalised.
+//! and normalised. An optional 4th field names the order the ordinal counts in
+//! (`(table, 2, yellow, west_to_east)` for "the second yellow table from the west"); the
+//! paper's three-field form means the default order (nearest first).
 //!
 //! Accepted forms (anywhere in the text; junk before and after is ignored):
 //! - the paper's: `[(table, third, yellow), (sofa, None, black)]` (quotes optional);
@@ -10,8 +12,10 @@
 //!
 //! Normalisation: objects lower-case, articles dropped, singular ("the Tables" -> "table");
 //! ordinals from words ("first".."twentieth"), digits ("2", "2nd"), "last" = -1, and
-//! "nearest"/"closest"/"none"/0 = unspecified (`None`); colours lower-case with the map's
-//! synonyms folded ("grey" -> "gray"), "none"/"any"/"" = `None`.
+//! "nearest"/"closest"/"none"/0 = unspecified (`None`); superlatives carry their order
+//! ("westernmost" = 1st west to east, "rightmost" = 1st right to left); colours lower-case
+//! with the map's synonyms folded ("grey" -> "gray"), "none"/"any"/"" = `None`; orders as
+//! map_core's names, also "from the west" / "from west to east" / "from the left".
 
 use serde::{Deserialize, Serialize};
 
@@ -24,6 +28,10 @@ pub struct Tuple {
     pub ordinal: Option<i64>,
     /// A lower-case colour word, or `None` for any colour.
     pub colour: Option<String>,
+    /// The order the ordinal counts in (a map_core order name such as "west_to_east");
+    /// `None` for the default (nearest first). Suites may leave it out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<String>,
 }
 
 impl Tuple {
@@ -34,13 +42,32 @@ impl Tuple {
             object: normalise_object(object),
             ordinal: ordinal.filter(|k| *k != 0),
             colour: colour.and_then(normalise_colour),
+            order: None,
         }
+    }
+
+    /// This tuple counting in `order` (a map_core order name or phrase; the default order
+    /// and unreadable names leave it `None`).
+    #[must_use]
+    pub fn with_order(mut self, order: Option<&str>) -> Self {
+        self.order = order.and_then(normalise_order);
+        self
     }
 
     /// This tuple with every field normalised (for comparing hand-written tuples).
     #[must_use]
     pub fn normalised(&self) -> Self {
         Self::new(&self.object, self.ordinal, self.colour.as_deref())
+            .with_order(self.order.as_deref())
+    }
+
+    /// The order as map_core's type (the default when unset).
+    #[must_use]
+    pub fn object_order(&self) -> map_core::ObjectOrder {
+        self.order
+            .as_deref()
+            .and_then(|o| map_core::ObjectOrder::parse(o).ok())
+            .unwrap_or(map_core::ObjectOrder::NearToFar)
     }
 
     /// Whether two tuples mean the same thing: same ordinal and colour after
@@ -53,7 +80,14 @@ impl Tuple {
             && map_core::canonical(&a.object) == map_core::canonical(&b.object)
     }
 
-    /// The paper's notation, e.g. `(table, 3, yellow)`; `None` for unspecified fields.
+    /// Whether the orders agree too (an unset order is the default, nearest first).
+    #[must_use]
+    pub fn same_order(&self, other: &Tuple) -> bool {
+        self.object_order() == other.object_order()
+    }
+
+    /// The paper's notation, e.g. `(table, 3, yellow)`; `None` for unspecified fields; a
+    /// 4th field when the order is not the default: `(table, 2, yellow, west_to_east)`.
     #[must_use]
     pub fn paper_form(&self) -> String {
         let k = match self.ordinal {
@@ -61,8 +95,12 @@ impl Tuple {
             Some(-1) => "last".to_string(),
             Some(k) => k.to_string(),
         };
+        let order = match self.object_order() {
+            map_core::ObjectOrder::NearToFar => String::new(),
+            o => format!(", {}", o.name()),
+        };
         format!(
-            "({}, {}, {})",
+            "({}, {}, {}{order})",
             self.object,
             k,
             self.colour.as_deref().unwrap_or("None")
@@ -77,10 +115,15 @@ pub fn tuples_paper_form(tuples: &[Tuple]) -> String {
     format!("[{}]", parts.join(", "))
 }
 
-/// Whether two tuple lists agree element by element (see [`Tuple::same_as`]).
+/// Whether two tuple lists agree element by element (see [`Tuple::same_as`]); where the
+/// expected list `b` names an order, `a`'s must agree with it too (suites written with the
+/// paper's three fields leave orders unchecked).
 #[must_use]
 pub fn same_tuples(a: &[Tuple], b: &[Tuple]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.same_as(y))
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| x.same_as(y) && (y.order.is_none() || x.same_order(y)))
 }
 
 /// Why a model's answer could not be read as tuples.
@@ -212,8 +255,9 @@ fn from_json(v: &serde_json::Value) -> Result<Option<Vec<Tuple>>, TupleParseErro
                 };
                 vec![
                     get(&["object", "name", "obj", "object_name"]),
-                    get(&["ordinal", "index", "k", "instance_idx", "order"]),
+                    get(&["ordinal", "index", "k", "instance_idx"]),
                     get(&["colour", "color", "object_color", "object_colour"]),
+                    get(&["order", "counting", "direction"]),
                 ]
             }
             serde_json::Value::Array(a) => a.iter().map(json_field).collect(),
@@ -273,9 +317,9 @@ fn clean_field(s: &str) -> String {
 
 fn tuple_from_fields(fields: &[String], index: usize) -> Result<Tuple, TupleParseError> {
     let bad = |message: String| TupleParseError::BadEntry { index, message };
-    if fields.is_empty() || fields.len() > 3 {
+    if fields.is_empty() || fields.len() > 4 {
         return Err(bad(format!(
-            "expected (object, ordinal, colour), got {} field(s)",
+            "expected (object, ordinal, colour[, order]), got {} field(s)",
             fields.len()
         )));
     }
@@ -284,18 +328,37 @@ fn tuple_from_fields(fields: &[String], index: usize) -> Result<Tuple, TuplePars
     if object_n.is_empty() || is_null_word(&object_n) {
         return Err(bad("the object name is empty".into()));
     }
-    let ordinal = match fields.get(1) {
-        Some(f) => parse_ordinal(&clean_field(f)).map_err(bad)?,
-        None => None,
+    let (ordinal, implied) = match fields.get(1) {
+        Some(f) => parse_ordinal_with_order(&clean_field(f)).map_err(bad)?,
+        None => (None, None),
     };
-    let colour = fields
+    let mut colour = fields
         .get(2)
         .map(|f| clean_field(f))
         .and_then(|c| normalise_colour(&c));
+    let mut order = match fields.get(3).map(|f| clean_field(f)) {
+        Some(o) if !is_null_word(&o.to_lowercase()) => Some(
+            normalise_order(&o)
+                .or_else(|| (map_core::ObjectOrder::parse(&o).is_ok()).then(String::new))
+                .ok_or_else(|| bad(format!("order {o:?} is not an order such as west_to_east")))?,
+        ),
+        _ => None,
+    }
+    .filter(|o| !o.is_empty());
+    // A direction written where the colour goes ("from the west" as a colour).
+    if let Some(c) = colour.clone() {
+        if !map_core::is_colour_word(&c) {
+            if let Some(o) = normalise_order(&c) {
+                colour = None;
+                order = order.or(Some(o));
+            }
+        }
+    }
     Ok(Tuple {
         object: object_n,
         ordinal,
         colour,
+        order: order.or(implied),
     })
 }
 
@@ -391,6 +454,71 @@ pub fn parse_ordinal(raw: &str) -> Result<Option<i64>, String> {
     Err(format!(
         "ordinal {raw:?} is not a number, an ordinal word, \"last\" or \"nearest\""
     ))
+}
+
+/// Superlatives that are the first in some order ("westernmost" = 1st from west to east).
+const SUPERLATIVES: &[(&str, &str)] = &[
+    ("westernmost", "west_to_east"),
+    ("westmost", "west_to_east"),
+    ("easternmost", "east_to_west"),
+    ("eastmost", "east_to_west"),
+    ("northernmost", "north_to_south"),
+    ("northmost", "north_to_south"),
+    ("southernmost", "south_to_north"),
+    ("southmost", "south_to_north"),
+    ("leftmost", "left_to_right"),
+    ("rightmost", "right_to_left"),
+];
+
+/// Reads an ordinal like [`parse_ordinal`], also accepting superlatives, which imply an
+/// order: "westernmost" is `(Some(1), Some("west_to_east"))`.
+///
+/// # Errors
+/// As [`parse_ordinal`].
+pub fn parse_ordinal_with_order(raw: &str) -> Result<(Option<i64>, Option<String>), String> {
+    let s = raw.trim().to_lowercase();
+    let s = s.trim_start_matches("the ").trim();
+    if let Some((_, o)) = SUPERLATIVES.iter().find(|(w, _)| *w == s) {
+        return Ok((Some(1), Some((*o).to_string())));
+    }
+    // A bare side or direction ("the west side of the table") counts nothing.
+    if matches!(
+        s,
+        "west" | "east" | "north" | "south" | "left" | "right" | "front" | "back" | "behind"
+    ) {
+        return Ok((None, None));
+    }
+    parse_ordinal(s).map(|k| (k, None))
+}
+
+/// Normalises an order: map_core's names ("west_to_east", "Left to right") and the
+/// phrases instructions use ("from the west", "west", "from west to east", "from the
+/// left", "counting from the north"). `None` for the default order (nearest first) and for
+/// words that are not an order.
+#[must_use]
+pub fn normalise_order(raw: &str) -> Option<String> {
+    let n = map_core::normalize(&clean_field(raw));
+    let n = n.trim_start_matches("counting ").trim();
+    let n = n.trim_start_matches("from ").trim();
+    let n = n.trim_start_matches("the ").trim();
+    let n = n.trim_end_matches(" side").trim();
+    let word = match n {
+        "west" | "western" => Some("west_to_east"),
+        "east" | "eastern" => Some("east_to_west"),
+        "north" | "northern" => Some("north_to_south"),
+        "south" | "southern" => Some("south_to_north"),
+        "left" => Some("left_to_right"),
+        "right" => Some("right_to_left"),
+        _ => None,
+    };
+    if let Some(w) = word {
+        return Some(w.to_string());
+    }
+    if let Some((_, o)) = SUPERLATIVES.iter().find(|(w, _)| *w == n) {
+        return Some((*o).to_string());
+    }
+    let o = map_core::ObjectOrder::parse(&n.replace(" to the ", " to ")).ok()?;
+    (o != map_core::ObjectOrder::NearToFar).then(|| o.name().to_string())
 }
 
 /// Normalises an object name: lower-case, no article or quotes, singular.
@@ -495,6 +623,51 @@ mod tests {
             "{e}"
         );
         assert!(e.to_string().contains("several"), "{e}");
+    }
+
+    #[test]
+    fn orders_as_a_fourth_field_and_from_superlatives() {
+        let got = parse_tuples(
+            "[(table, 2, yellow, west_to_east), (plant, easternmost, None), (chair, 3, brown, from the east), (lamp, 1, None, near_to_far)]",
+        )
+        .unwrap();
+        assert_eq!(got[0].order.as_deref(), Some("west_to_east"));
+        assert_eq!(
+            (got[1].ordinal, got[1].order.as_deref()),
+            (Some(1), Some("east_to_west"))
+        );
+        assert_eq!(got[2].order.as_deref(), Some("east_to_west"));
+        assert_eq!(got[3].order, None, "the default order is no order");
+        assert_eq!(got[0].paper_form(), "(table, 2, yellow, west_to_east)");
+        assert_eq!(got[3].paper_form(), "(lamp, 1, None)");
+        let json = parse_tuples(
+            r#"[{"object": "chair", "ordinal": 2, "colour": null, "order": "left to right"}]"#,
+        )
+        .unwrap();
+        assert_eq!(json[0].order.as_deref(), Some("left_to_right"));
+        assert!(parse_tuples("[(chair, 2, None, sideways)]").is_err());
+    }
+
+    #[test]
+    fn a_side_in_the_ordinal_slot_counts_nothing() {
+        let got = parse_tuples("[(table, west, black), (tv, None, None)]").unwrap();
+        assert_eq!((got[0].ordinal, got[0].order.as_deref()), (None, None));
+        assert_eq!(got[0].colour.as_deref(), Some("black"));
+    }
+
+    #[test]
+    fn a_direction_in_the_colour_slot_becomes_the_order() {
+        let got = parse_tuples("[(table, 2, west)]").unwrap();
+        assert_eq!(got[0].colour, None);
+        assert_eq!(got[0].order.as_deref(), Some("west_to_east"));
+    }
+
+    #[test]
+    fn suites_without_orders_do_not_score_them() {
+        let got = vec![Tuple::new("chair", Some(2), None).with_order(Some("left_to_right"))];
+        assert!(same_tuples(&got, &[Tuple::new("chair", Some(2), None)]));
+        let want = vec![Tuple::new("chair", Some(2), None).with_order(Some("right_to_left"))];
+        assert!(!same_tuples(&got, &want));
     }
 
     #[test]
