@@ -177,3 +177,56 @@ fn deterministic_goto_plans_only_when_words_agree() {
     assert!(simple_goto_script("go to the red sofa", &one, Some(&map)).is_some());
     assert_eq!(simple_goto_script("turn left", &[], Some(&map)), None);
 }
+
+#[test]
+fn deterministic_goto_plans_read_orders_superlatives_and_verbless_clauses() {
+    let map = flat_a();
+    let t = vec![
+        Tuple::new("table", Some(2), Some("yellow")).with_order(Some("west_to_east")),
+        Tuple::new("plant", Some(1), None).with_order(Some("east_to_west")),
+        Tuple::new("chair", None, Some("red")),
+        Tuple::new("kitchen", None, None),
+    ];
+    let s = simple_goto_script(
+        "go to the second yellow table from the west, then the easternmost plant, then the red chair nearest to you, and finally to the kitchen",
+        &t,
+        Some(&map),
+    )
+    .unwrap();
+    assert_eq!(
+        s,
+        "let target_1 = agent.get_obj_attributes(\"table\", 2, \"yellow\", \"west_to_east\");\nagent.move_to_object(target_1);\nlet target_2 = agent.get_obj_attributes(\"plant\", 1, \"\", \"east_to_west\");\nagent.move_to_object(target_2);\nlet target_3 = agent.get_obj_attributes(\"chair\", 0, \"red\");\nagent.move_to_object(target_3);\nagent.move_to_object(\"kitchen\");\n"
+    );
+    // The tuple's order must agree with the words.
+    let no_order = vec![Tuple::new("table", Some(2), Some("yellow"))];
+    assert_eq!(
+        simple_goto_script(
+            "go to the second yellow table from the west",
+            &no_order,
+            Some(&map)
+        ),
+        None
+    );
+    // An unknown trailing phrase is left to the LLM.
+    let one = vec![Tuple::new("chair", None, None)];
+    assert_eq!(
+        simple_goto_script("go to the chair from yesterday", &one, Some(&map)),
+        None
+    );
+}
+
+#[test]
+fn picks_nothing_uses_are_reported() {
+    let map = flat_a();
+    let t = vec![Tuple::new("chair", Some(2), Some("red"))];
+    let f = check_script(
+        "let chair = agent.get_obj_attributes(\"chair\", 2, \"red\");\nagent.turn(90);",
+        &t,
+        Some(&map),
+    )
+    .unwrap();
+    assert_eq!(f.len(), 1, "{f:?}");
+    assert_eq!(f[0].kind, FindingKind::Unused);
+    assert_eq!(f[0].pos.map(|p| p.line), Some(1));
+    assert!(f[0].message.contains("`chair` is picked but never used"));
+}

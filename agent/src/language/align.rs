@@ -326,6 +326,21 @@ fn mentions(line: &str, var: &str) -> bool {
     })
 }
 
+/// Picks bound to a variable that nothing uses afterwards: `(line, variable)`, 1-based.
+/// A script that picks "the second chair" and never goes there did not do what was asked.
+pub(crate) fn unused_picks(src: &str) -> Vec<(usize, String)> {
+    let lines: Vec<&str> = src.lines().collect();
+    let mut out = Vec::new();
+    for (i, l) in lines.iter().enumerate() {
+        if let Some(var) = pick_binding(l) {
+            if !lines[i + 1..].iter().any(|later| mentions(later, var)) {
+                out.push((i + 1, var.to_string()));
+            }
+        }
+    }
+    out
+}
+
 /// Moves top-level picks down to just before their first use when moves come between
 /// (see the module docs). Lines keep their text; only their order changes.
 fn sink_picks(src: &str, mut fixes: Vec<Fix>) -> (String, Vec<Fix>) {

@@ -393,6 +393,15 @@ pub fn check_script(
             }
         }
     }
+    for (line, var) in super::align::unused_picks(src) {
+        out.push(Finding {
+            pos: Some(Pos { line, col: 1 }),
+            kind: FindingKind::Unused,
+            message: format!(
+                "`{var}` is picked but never used: go to it (agent.move_to_object({var})), face it or pass it to the function the instruction asks for"
+            ),
+        });
+    }
     for (i, t) in tuples.iter().enumerate() {
         if used[i] || map.is_some_and(|m| is_region(m, &t.object)) {
             continue;

@@ -413,8 +413,18 @@ pub fn simple_goto_script(
         ] {
             c = c.strip_prefix(lead).unwrap_or(c);
         }
-        let rest = GOTO_PREFIXES.iter().find_map(|p| c.strip_prefix(p))?;
+        // "go to A, then B, then to C": later clauses may leave the verb out.
+        let rest = match GOTO_PREFIXES.iter().find_map(|p| c.strip_prefix(p)) {
+            Some(r) => r,
+            None if i > 0 => ["to ", "into ", ""]
+                .iter()
+                .find_map(|p| c.strip_prefix(p))
+                .filter(|r| r.starts_with("the ") || r.starts_with("a "))?,
+            None => return None,
+        };
+        let (rest, trailing_order) = strip_trailing_qualifier(rest)?;
         let mut ordinal: Option<i64> = None;
+        let mut order: Option<String> = trailing_order;
         let mut colour: Option<String> = None;
         let mut noun: Vec<&str> = Vec::new();
         for w in rest.split_whitespace() {
@@ -422,10 +432,16 @@ pub fn simple_goto_script(
                 continue;
             }
             if noun.is_empty() && ordinal.is_none() && colour.is_none() {
-                if let Ok(k) = parse_ordinal(w) {
+                if let Ok((k, o)) = super::tuples::parse_ordinal_with_order(w) {
                     // "nearest"/"closest" read as unspecified.
                     if k.is_some() || matches!(w, "nearest" | "closest") {
                         ordinal = k;
+                        if o.is_some() {
+                            if order.is_some() {
+                                return None;
+                            }
+                            order = o;
+                        }
                         continue;
                     }
                 }
@@ -443,7 +459,8 @@ pub fn simple_goto_script(
             return None;
         }
         let object = normalise_object(&noun.join(" "));
-        if object != t.object || ordinal != t.ordinal || colour != t.colour {
+        let mine = Tuple::new(&object, ordinal, colour.as_deref()).with_order(order.as_deref());
+        if object != t.object || ordinal != t.ordinal || colour != t.colour || !mine.same_order(t) {
             return None;
         }
         let name = object.replace(['"', '\\'], "");
@@ -459,14 +476,45 @@ pub fn simple_goto_script(
             script.push_str(&format!("agent.move_to_object(\"{name}\");\n"));
         } else {
             let v = format!("target_{}", i + 1);
+            let order = match t.object_order() {
+                ObjectOrder::NearToFar => String::new(),
+                o => format!(", \"{}\"", o.name()),
+            };
             script.push_str(&format!(
-                "let {v} = agent.get_obj_attributes(\"{name}\", {}, \"{}\");\nagent.move_to_object({v});\n",
+                "let {v} = agent.get_obj_attributes(\"{name}\", {}, \"{}\"{order});\nagent.move_to_object({v});\n",
                 ordinal.unwrap_or(0),
                 colour.as_deref().unwrap_or("")
             ));
         }
     }
     Some(script)
+}
+
+/// Splits a counting phrase off the end of a "go to" clause: "the second table from the
+/// west" -> ("the second table", west_to_east); "counting from west to east" likewise;
+/// "nearest to you" / "closest to you" / "nearest to it" (the default order: distances
+/// from where the robot is) are dropped. `None` when a trailing phrase is not understood
+/// ("the chair next to the desk" is for the LLM path).
+fn strip_trailing_qualifier(rest: &str) -> Option<(&str, Option<String>)> {
+    for q in [
+        " nearest to you",
+        " closest to you",
+        " nearest to it",
+        " closest to it",
+        " nearest to the robot",
+    ] {
+        if let Some(r) = rest.strip_suffix(q) {
+            return Some((r, None));
+        }
+    }
+    for lead in [" counting from ", " from "] {
+        if let Some(i) = rest.rfind(lead) {
+            let phrase = &rest[i + 1..];
+            let o = super::tuples::normalise_order(phrase)?;
+            return Some((&rest[..i], Some(o)));
+        }
+    }
+    Some((rest, None))
 }
 
 /// The source line `line` (1-based) of `src`, for quoting in feedback.
