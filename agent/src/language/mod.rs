@@ -11,6 +11,7 @@
 
 mod align;
 mod checks;
+mod evidence;
 mod grammar;
 mod pipeline;
 mod prompts;
@@ -20,6 +21,7 @@ mod tuples;
 
 pub use align::{align_script, Fix};
 pub use checks::{check_script, library_calls, Arg, Finding, FindingKind, LibCall, Pos};
+pub use evidence::missing_evidence;
 pub use grammar::tuple_grammar;
 pub use pipeline::{
     extract_tuples, extract_tuples_with, plan_instruction, scene_summary, simple_goto_script,

@@ -12,6 +12,7 @@ use crate::backend::{ChatMessage, Completion, CompletionRequest, LlmBackend, Llm
 
 use super::align::{align_script, Fix};
 use super::checks::check_script;
+use super::evidence::missing_evidence;
 use super::prompts::{PromptError, Prompts};
 use super::script::{extract_code, pythonic_fixups};
 use super::tuples::{
@@ -110,6 +111,10 @@ pub struct PlanOptions {
     /// Constrain step 1's answer with [`crate::tuple_grammar`] (backends that take GBNF:
     /// llama; default on).
     pub tuple_grammar: bool,
+    /// Compare step 1's tuples with the instruction's ordinal, superlative, counting and
+    /// colour words and ask once more when they miss some (default on; see
+    /// [`crate::missing_evidence`]).
+    pub tuple_check: bool,
     /// Constrain step 2's scripts with [`planner_dsl::script_grammar`] (default off: see
     /// README, "Grammars", for what it costs and changes).
     pub script_grammar: bool,
@@ -125,6 +130,7 @@ impl Default for PlanOptions {
             dry_run: true,
             scene_in_extract: false,
             tuple_grammar: true,
+            tuple_check: true,
             script_grammar: false,
         }
     }
@@ -309,10 +315,32 @@ pub fn extract_tuples_with(
     let c = backend.complete(&req)?;
     let mut timing = Timing::default();
     timing.add(&c);
-    let tuples = parse_tuples(&c.text).map_err(|source| LanguageError::Tuples {
+    let mut tuples = parse_tuples(&c.text).map_err(|source| LanguageError::Tuples {
         source,
         answer: c.text.clone(),
     })?;
+    if options.tuple_check {
+        let missing = missing_evidence(instruction, &tuples);
+        if !missing.is_empty() {
+            // One more look, told what the words say; kept only if it misses less.
+            tracing::debug!(
+                ?missing,
+                "tuples miss words of the instruction; asking again"
+            );
+            req.messages.push(ChatMessage::assistant(c.text.clone()));
+            req.messages.push(ChatMessage::user(format!(
+                "Check that list against the instruction: {}. Answer with the corrected list only, on one line.",
+                missing.join("; ")
+            )));
+            let again = backend.complete(&req)?;
+            timing.add(&again);
+            if let Ok(t2) = parse_tuples(&again.text) {
+                if missing_evidence(instruction, &t2).len() < missing.len() {
+                    tuples = t2;
+                }
+            }
+        }
+    }
     timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
     Ok((tuples, timing))
 }
