@@ -77,6 +77,24 @@ fn pick_args(name: &str, t: &Tuple) -> String {
     s
 }
 
+/// `name` without leading colour, ordinal or superlative words ("red chair" -> "chair",
+/// "second yellow table" -> "table"); unchanged when nothing would be left.
+fn strip_modifiers(name: &str) -> String {
+    let words: Vec<&str> = name.split_whitespace().collect();
+    let skip = words
+        .iter()
+        .take_while(|w| {
+            map_core::is_colour_word(w)
+                || super::tuples::parse_ordinal_with_order(w).is_ok_and(|(k, _)| k.is_some())
+        })
+        .count();
+    if skip == 0 || skip == words.len() {
+        name.to_string()
+    } else {
+        words[skip..].join(" ")
+    }
+}
+
 /// Byte offset of a 1-based line and column in `src`.
 fn offset_of(src: &str, pos: Pos) -> Option<usize> {
     let mut off = 0usize;
@@ -167,7 +185,9 @@ pub fn align_script(src: &str, tuples: &[Tuple], map: Option<&IvlMap>) -> (Strin
     // (start, end, replacement, pos)
     let mut edits: Vec<(usize, usize, String, Pos)> = Vec::new();
     let mut take = |name: &str| -> Option<usize> {
-        let key = canonical(name);
+        // "red chair" names a chair: a colour or ordinal word glued to the name is the
+        // model restating the tuple.
+        let key = canonical(&strip_modifiers(name));
         let i = (0..tuples.len()).find(|&i| !used[i] && canonical(&tuples[i].object) == key)?;
         used[i] = true;
         Some(i)
@@ -195,7 +215,7 @@ pub fn align_script(src: &str, tuples: &[Tuple], map: Option<&IvlMap>) -> (Strin
                 .all(|a| matches!(a, Arg::Str(_) | Arg::Int(_) | Arg::Unit));
             if let Some(i) = take(name) {
                 if literal {
-                    let args = format!("({})", pick_args(name, &tuples[i]));
+                    let args = format!("({})", pick_args(&tuples[i].object, &tuples[i]));
                     if src[open..end] != args {
                         edits.push((open, end, args, call.pos));
                     }
@@ -454,6 +474,16 @@ mod tests {
             "agent.move_to_object(agent.get_obj_attributes(\"sofa\", 0, \"red\"));\nagent.move_to_object(\"lamp\");"
         );
         assert_eq!(fixes.len(), 1);
+    }
+
+    #[test]
+    fn a_colour_glued_to_the_name_is_the_tuples_object() {
+        let src = "let c = agent.get_obj_attributes(\"white counter\", (), \"white\");";
+        let (out, _) = align_script(src, &[t("counter", None, Some("white"), None)], None);
+        assert_eq!(
+            out,
+            "let c = agent.get_obj_attributes(\"counter\", 0, \"white\");"
+        );
     }
 
     #[test]

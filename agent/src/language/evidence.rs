@@ -24,96 +24,151 @@ fn words(instruction: &str) -> Vec<String> {
         .collect()
 }
 
-/// What the tuples miss of what the instruction says, one message per kind of miss.
+/// A modifier of the instruction: what it requires of its noun's tuple.
+#[derive(Debug, Clone, PartialEq)]
+enum Need {
+    /// Ordinal 1 in this order (a superlative).
+    First(String),
+    /// This ordinal.
+    Ordinal(i64),
+    /// This colour.
+    Colour(String),
+}
+
+impl Need {
+    fn met_by(&self, t: &Tuple) -> bool {
+        match self {
+            Need::First(o) => t.ordinal == Some(1) && t.order.as_deref() == Some(o.as_str()),
+            Need::Ordinal(k) => t.ordinal == Some(*k),
+            Need::Colour(c) => t.colour.as_deref() == Some(c.as_str()),
+        }
+    }
+
+    fn describe(&self) -> String {
+        match self {
+            Need::First(o) => format!("ordinal 1 counted {o} (4th field {o})"),
+            Need::Ordinal(-1) => "ordinal last".to_string(),
+            Need::Ordinal(k) => format!("ordinal {k}"),
+            Need::Colour(c) => format!("colour {c}"),
+        }
+    }
+}
+
+/// What a word at `i` requires, if it is a modifier.
+fn need_of(w: &[String], i: usize) -> Option<Need> {
+    let word = &w[i];
+    if let Ok((Some(1), Some(order))) = parse_ordinal_with_order(word) {
+        return Some(Need::First(order));
+    }
+    // Only "the second ...": "first go to the kitchen" counts nothing.
+    let after_the = i > 0 && w[i - 1] == "the";
+    let ordinal_like = word.chars().next().is_some_and(char::is_alphabetic)
+        || ["st", "nd", "rd", "th"].iter().any(|s| word.ends_with(s));
+    if after_the && ordinal_like {
+        if let Ok(Some(k)) = parse_ordinal(word) {
+            if k != -1 || word == "last" {
+                return Some(Need::Ordinal(k));
+            }
+        }
+    }
+    if map_core::is_colour_word(word) {
+        return normalise_colour(word).map(Need::Colour);
+    }
+    None
+}
+
+fn is_modifier(w: &[String], i: usize) -> bool {
+    need_of(w, i).is_some() || matches!(w[i].as_str(), "nearest" | "closest" | "the")
+}
+
+/// The noun a modifier at `i` belongs to: the first following word that is no modifier,
+/// singular, with its index.
+fn noun_after(w: &[String], i: usize) -> Option<(usize, String)> {
+    (i + 1..w.len().min(i + 5))
+        .find(|&j| !is_modifier(w, j))
+        .map(|j| (j, map_core::singular(&w[j])))
+}
+
+fn first_word(object: &str) -> String {
+    map_core::singular(object.split_whitespace().next().unwrap_or(""))
+}
+
+/// What the tuples miss of what the instruction says. Where a modifier's noun can be
+/// matched to a tuple (the j-th "plant" of the instruction is the j-th plant tuple) the
+/// message names it; otherwise occurrences are counted.
 #[must_use]
 pub fn missing_evidence(instruction: &str, tuples: &[Tuple]) -> Vec<String> {
     let w = words(instruction);
     let mut out = Vec::new();
-    let mut seen: Vec<String> = Vec::new();
-    for (i, word) in w.iter().enumerate() {
-        if seen.contains(word) {
+    let mut counted: Vec<String> = Vec::new();
+    for i in 0..w.len() {
+        let Some(need) = need_of(&w, i) else {
             continue;
-        }
-        let said = w.iter().filter(|x| *x == word).count();
-        // Superlatives: the 1st in an order.
-        if let Ok((Some(1), Some(order))) = parse_ordinal_with_order(word) {
-            seen.push(word.clone());
-            let have = tuples
-                .iter()
-                .filter(|t| t.ordinal == Some(1) && t.order.as_deref() == Some(order.as_str()))
+        };
+        let located = noun_after(&w, i).and_then(|(at, noun)| {
+            let nth = (0..at)
+                .filter(|&k| map_core::singular(&w[k]) == noun && !is_modifier(&w, k))
                 .count();
-            if have < said {
-                out.push(format!(
-                    "\"{word}\" means ordinal 1 counted {order}: that object's tuple is (object, 1, colour, {order})"
-                ));
+            let same: Vec<&Tuple> = tuples
+                .iter()
+                .filter(|t| first_word(&t.object) == noun || map_core::singular(&t.object) == noun)
+                .collect();
+            same.get(nth).map(|t| (noun, nth, *t))
+        });
+        match located {
+            Some((noun, nth, t)) => {
+                if !need.met_by(t) {
+                    out.push(format!(
+                        "\"{} {noun}\" is the {} {noun} mentioned: its tuple needs {}",
+                        w[i],
+                        map_core::ordinal_word(i64::try_from(nth).unwrap_or(0) + 1),
+                        need.describe()
+                    ));
+                }
             }
-            continue;
-        }
-        // Counting phrases: "from the west", "from west to east".
-        if word == "from" {
-            let phrase = w[i..w.len().min(i + 5)].join(" ");
-            let order = normalise_order(&w[i..w.len().min(i + 3)].join(" "))
-                .or_else(|| normalise_order(&phrase))
-                .or_else(|| normalise_order(&w[i..w.len().min(i + 4)].join(" ")));
-            if let Some(order) = order {
-                let key = format!("from:{order}");
-                if seen.contains(&key) {
+            None => {
+                if counted.contains(&w[i]) {
                     continue;
                 }
-                seen.push(key);
-                let said = count_orders(&w, &order);
-                let have = tuples
-                    .iter()
-                    .filter(|t| t.order.as_deref() == Some(order.as_str()))
+                counted.push(w[i].clone());
+                let said = (0..w.len())
+                    .filter(|&k| w[k] == w[i] && need_of(&w, k).as_ref() == Some(&need))
                     .count();
+                let have = tuples.iter().filter(|t| need.met_by(t)).count();
                 if have < said {
                     out.push(format!(
-                        "the instruction counts {order} (\"{}\"): give that object's tuple a 4th field {order}",
-                        w[i..w.len().min(i + 3)].join(" ")
+                        "\"{}\" is in the instruction but no tuple has {}",
+                        w[i],
+                        need.describe()
                     ));
                 }
             }
+        }
+    }
+    // Counting phrases: "from the west", "from west to east".
+    let mut seen_orders: Vec<String> = Vec::new();
+    for i in 0..w.len() {
+        if w[i] != "from" {
             continue;
         }
-        // Ordinal words and numbers ("second", "2nd", "last"); "nearest" is no ordinal.
-        let is_ordinal_word = word.chars().next().is_some_and(char::is_alphabetic)
-            || word.ends_with("st")
-            || word.ends_with("nd")
-            || word.ends_with("rd")
-            || word.ends_with("th");
-        // Only "the second ...": "first go to the kitchen" counts nothing.
-        let after_the = i > 0 && w[i - 1] == "the";
-        if is_ordinal_word && after_the {
-            if let Ok(Some(k)) = parse_ordinal(word) {
-                if k == -1 && !matches!(word.as_str(), "last") {
-                    continue;
-                }
-                seen.push(word.clone());
-                let have = tuples.iter().filter(|t| t.ordinal == Some(k)).count();
-                if have < said {
-                    let k_text = if k == -1 {
-                        "last".to_string()
-                    } else {
-                        k.to_string()
-                    };
-                    out.push(format!(
-                        "\"{word}\" is in the instruction but no tuple has ordinal {k_text} for it"
-                    ));
-                }
-                continue;
-            }
+        let order = [3usize, 5, 4]
+            .iter()
+            .find_map(|len| normalise_order(&w[i..w.len().min(i + len)].join(" ")));
+        let Some(order) = order else { continue };
+        if seen_orders.contains(&order) {
+            continue;
         }
-        // Colour words.
-        if map_core::is_colour_word(word) {
-            seen.push(word.clone());
-            let c = normalise_colour(word);
-            let have = tuples.iter().filter(|t| t.colour == c).count();
-            if have < said {
-                out.push(format!(
-                    "\"{word}\" is in the instruction but no tuple has the colour {}",
-                    c.as_deref().unwrap_or(word)
-                ));
-            }
+        seen_orders.push(order.clone());
+        let said = count_orders(&w, &order);
+        let have = tuples
+            .iter()
+            .filter(|t| t.order.as_deref() == Some(order.as_str()))
+            .count();
+        if have < said {
+            out.push(format!(
+                "the instruction counts {order} (\"{}\"): give that object's tuple a 4th field {order}",
+                w[i..w.len().min(i + 3)].join(" ")
+            ));
         }
     }
     out
@@ -160,7 +215,18 @@ mod tests {
         ];
         let m = missing_evidence(i, &got);
         assert_eq!(m.len(), 1, "{m:?}");
-        assert!(m[0].contains("northernmost"), "{m:?}");
+        assert_eq!(
+            m[0],
+            "\"northernmost plant\" is the 2nd plant mentioned: its tuple needs ordinal 1 counted north_to_south (4th field north_to_south)"
+        );
+        // Swapped: both plants are named.
+        let swapped = vec![
+            t("plant", Some(1), None, Some("north_to_south")),
+            got[1].clone(),
+            t("plant", Some(1), None, Some("east_to_west")),
+            got[3].clone(),
+        ];
+        assert_eq!(missing_evidence(i, &swapped).len(), 2);
         let fixed = vec![
             got[0].clone(),
             got[1].clone(),
