@@ -238,11 +238,7 @@ fn label_maps_and_masks_are_checked() {
 type Decision = (u16, f64, Vec<(u16, u64)>);
 
 /// Eq. 2 written the obvious way, cell by cell, as the check.
-fn reference(
-    labels: &Grid<u16>,
-    m: &Mask,
-    cfg: &LabelConfig,
-) -> Result<Decision, &'static str> {
+fn reference(labels: &Grid<u16>, m: &Mask, cfg: &LabelConfig) -> Result<Decision, &'static str> {
     let mut counts: BTreeMap<u16, u64> = BTreeMap::new();
     let mut area = 0u64;
     for r in 0..labels.rows() {
