@@ -56,9 +56,10 @@ pub use crate::perception::{
     ciede2000, eq2_scores, label_masks, read_sam_masks, sam_masks_from_str, srgb_to_lab,
     unique_labels, write_sam_masks, write_sam_masks_to, BuildConfig, BuiltMap, ColourClassifier,
     ColourConfig, ColourEvidence, ColourPalette, DropReason, DroppedMask, KeptMask, LabelConfig,
-    LabelMap, LabelScore, Labelling, Mask, MaskColour, MaskLabel, MaskLocation, PaletteColour,
-    PerceptionError, PerceptionInputs, Rle, RleError, SamMask, SegmentationForm, BASIC_COLOURS,
-    BASIC_EXTRA_PROTOTYPES, DEFAULT_ROBOT_RADIUS_M, FLOOR_RGB, MAX_MASK_CELLS, OTHER,
+    LabelMap, LabelScore, Labelling, Mask, MaskColour, MaskLabel, MaskLocation, NoiseError,
+    NoiseLog, PaletteColour, PerceptionError, PerceptionInputs, PerceptionNoise, Rle, RleError,
+    SamMask, SegmentationForm, BASIC_COLOURS, BASIC_EXTRA_PROTOTYPES, DEFAULT_MERGE_RADIUS_M,
+    DEFAULT_ROBOT_RADIUS_M, FLOOR_RGB, MAX_MASK_CELLS, OTHER,
 };
 pub use crate::persist::{JsonLocation, PersistError, MAP_FORMAT};
 pub use crate::planner::{
@@ -68,13 +69,13 @@ pub use crate::planner::{
 pub use crate::query::{ordinal_word, ObjectOrder, QueryError};
 pub use crate::reconstruct::{
     base_from_pose2d, import_vlmaps_legacy, map_frame, parse_poses_txt, pose2d_from_base,
-    read_depth, read_poses_txt, read_rgb_png, reconstruct, reconstruct_with_progress,
-    render_rgbd, vlmaps_grid_frame, world_poses, write_depth_npy, write_depth_png,
-    write_poses_txt, write_rgb_png, write_vlmaps_legacy, Anchor, CameraInfo, FeatureGrid,
-    FrameFiles, FramePose, Intrinsics, MapSpec, PoseConvention, ReconstructError,
-    ReconstructOptions, RgbdDataset, RgbdFrame, RgbdRenderer, SyntheticOptions, TopDownBuilder,
-    TopDownMaps, VlmapsCrop, VlmapsImportOptions, VlmapsLegacyMap, VlmapsWindow, WorldPoses,
-    DEFAULT_OBJECT_HEIGHT, RGBD_FORMAT,
+    read_depth, read_poses_txt, read_rgb_png, reconstruct, reconstruct_with_progress, render_rgbd,
+    vlmaps_grid_frame, world_poses, write_depth_npy, write_depth_png, write_poses_txt,
+    write_rgb_png, write_vlmaps_legacy, Anchor, CameraInfo, FeatureGrid, FrameFiles, FramePose,
+    Intrinsics, MapSpec, PoseConvention, ReconstructError, ReconstructOptions, RgbdDataset,
+    RgbdFrame, RgbdRenderer, SyntheticOptions, TopDownBuilder, TopDownMaps, VlmapsCrop,
+    VlmapsImportOptions, VlmapsLegacyMap, VlmapsWindow, WorldPoses, DEFAULT_OBJECT_HEIGHT,
+    RGBD_FORMAT,
 };
 pub use crate::render::{
     auto_scale, colour_rgb, render_png, render_rgb, render_trajectory_png, RenderError,

@@ -224,7 +224,21 @@ impl IvlMap {
     }
 }
 
-/// Recompute `label_id` (1-based, west to east then north to south by centroid) and
+/// Resolution of the counting order: centroid coordinates are compared after
+/// rounding to this many metres (1 micrometre), so two instances whose centroids
+/// differ only by floating-point noise (3.599999999999996 and 3.5999999999999934,
+/// from rotated footprints) count as level and the next rule decides.
+pub(crate) const LABEL_ORDER_RESOLUTION_M: f64 = 1e-6;
+
+/// A coordinate on the [`LABEL_ORDER_RESOLUTION_M`] lattice (rounding, not a
+/// tolerance, so the order stays transitive).
+fn order_key(v: f64) -> i64 {
+    // `as` saturates; map coordinates are far inside +-9e12 m.
+    (v / LABEL_ORDER_RESOLUTION_M).round() as i64
+}
+
+/// Recompute `label_id` (1-based, west to east then north to south by centroid,
+/// each compared at [`LABEL_ORDER_RESOLUTION_M`]; then by id) and
 /// `num_of_same_class` for every instance.
 pub(crate) fn assign_label_ids(instances: &mut [Instance]) {
     let mut labels: Vec<String> = instances.iter().map(|i| i.label.clone()).collect();
@@ -236,8 +250,9 @@ pub(crate) fn assign_label_ids(instances: &mut [Instance]) {
             .collect();
         idx.sort_by(|&a, &b| {
             let (pa, pb) = (instances[a].centroid, instances[b].centroid);
-            pa.x.total_cmp(&pb.x)
-                .then(pb.y.total_cmp(&pa.y))
+            order_key(pa.x)
+                .cmp(&order_key(pb.x))
+                .then(order_key(pb.y).cmp(&order_key(pa.y)))
                 .then(instances[a].id.cmp(&instances[b].id))
         });
         let n = idx.len() as u32;
@@ -363,6 +378,47 @@ mod tests {
         assert_eq!((west.label_id, east.label_id), (1, 2));
         assert_eq!(west.num_of_same_class, 2);
         assert_eq!(m.instance_by_id(3).unwrap().num_of_same_class, 1);
+    }
+
+    /// Regression: office-b's grey chairs 20 (3.6, 8.775, yaw 180) and 22 (3.6,
+    /// 7.025) have centroids x = 3.599999999999996 and 3.5999999999999934 after
+    /// rotation, so 22 used to count before 20; the order must follow the
+    /// documented north-first rule, not the float noise.
+    #[test]
+    fn assign_label_ids_ties_on_float_noise_go_north_first() {
+        let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../examples/scenes/office-b.scene.json");
+        let m = IvlMap::from_scene(&Scene::from_path(&p).unwrap());
+        let (c20, c22) = (m.instance_by_id(20).unwrap(), m.instance_by_id(22).unwrap());
+        assert!((c20.centroid.x - c22.centroid.x).abs() < 1e-9);
+        assert!(c20.centroid.y > c22.centroid.y);
+        assert_eq!(c20.label_id + 1, c22.label_id, "{c20:?}\n{c22:?}");
+
+        // The same pair by hand, with the noise on the southern one's side too.
+        let m = IvlMap::from_scene(&scene());
+        let mut north = m.instance_by_id(2).unwrap().clone();
+        let mut south = north.clone();
+        north.id = 9;
+        north.centroid = Point::new(3.6000000000000005, 3.0);
+        south.id = 8;
+        south.centroid = Point::new(3.6, 1.0);
+        for (n, s) in [(0.0, 0.0), (0.0, 4e-16), (4e-16, 0.0)] {
+            let mut v = vec![south.clone(), north.clone()];
+            v[1].centroid.x += n;
+            v[0].centroid.x += s;
+            assign_label_ids(&mut v);
+            assert_eq!((v[1].label_id, v[0].label_id), (1, 2), "{n} {s}");
+        }
+        // A real difference (1 mm) still orders west first.
+        let mut v = vec![south.clone(), north.clone()];
+        v[0].centroid.x = 3.599;
+        assign_label_ids(&mut v);
+        assert_eq!((v[0].label_id, v[1].label_id), (1, 2));
+        // Level on both axes: the lower id first.
+        let mut v = vec![north.clone(), north.clone()];
+        v[1].id = 3;
+        assign_label_ids(&mut v);
+        assert_eq!((v[1].label_id, v[0].label_id), (1, 2));
     }
 
     #[test]

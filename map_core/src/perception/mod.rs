@@ -13,6 +13,7 @@
 //! | colour | [`ColourClassifier`] with [`ColourConfig`] / [`ColourPalette`] | RGB pixels of a mask -> [`MaskColour`] |
 //! | assembly | [`IvlMap::from_perception`] with [`BuildConfig`] | [`PerceptionInputs`] -> [`BuiltMap`] (map + kept + dropped) |
 //! | simulated perception | [`PerceptionInputs::from_scene`] | a scene -> the inputs a perfect perception stack would give |
+//! | noise | [`PerceptionInputs::with_noise`] with [`PerceptionNoise`] | inputs -> corrupted inputs + [`NoiseLog`] (label flips, split/merged/dropped masks, colour shifts; seeded) |
 //!
 //! Conventions: every layer and mask is on the map's [`GridFrame`] (row 0 = north
 //! edge, column 0 = west edge; a bird's-eye image's pixel (x, y) is cell (row y,
@@ -78,6 +79,7 @@ mod colour;
 mod error;
 mod labelling;
 mod mask;
+mod noise;
 mod sam;
 
 pub use assemble::{
@@ -94,6 +96,7 @@ pub use labelling::{
     LabelScore, Labelling, MaskLabel,
 };
 pub use mask::{Mask, Rle, RleError, MAX_MASK_CELLS};
+pub use noise::{NoiseError, NoiseLog, PerceptionNoise, DEFAULT_MERGE_RADIUS_M};
 pub use sam::{
     read_sam_masks, sam_masks_from_str, write_sam_masks, write_sam_masks_to, SamMask,
     SegmentationForm,
