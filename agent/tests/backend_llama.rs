@@ -662,3 +662,26 @@ fn pipeline_requests_hit_the_cache_with_several_slots() {
         "several slots: most prompt tokens come from the cache: {four:?}"
     );
 }
+
+#[test]
+fn ignore_eos_generates_exactly_max_tokens() {
+    let _g = serial();
+    let Some(path) = model(SMOL) else { return };
+    let req = ask("You are terse.", "Say hi.", 64);
+    let mut cfg = LlamaCppConfig::new(&path);
+    cfg.n_ctx = 1024;
+    let stops = LlamaCppBackend::new(cfg.clone())
+        .unwrap()
+        .complete(&req)
+        .unwrap();
+    assert_eq!(stops.finish_reason, FinishReason::Stop, "{stops:?}");
+    assert!(stops.completion_tokens < 64, "{stops:?}");
+    cfg.ignore_eos = true;
+    let full = LlamaCppBackend::new(cfg).unwrap().complete(&req).unwrap();
+    assert_eq!(full.completion_tokens, 64, "{full:?}");
+    assert_eq!(full.finish_reason, FinishReason::Length);
+    assert!(
+        full.text.starts_with(&stops.text),
+        "{stops:?} then {full:?}"
+    );
+}

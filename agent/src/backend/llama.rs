@@ -70,6 +70,9 @@ pub struct LlamaCppConfig {
     pub prefix_cache: bool,
     /// Prompt prefixes kept in the KV cache at once (llama.cpp sequences; default 4).
     pub n_slots: u32,
+    /// Keep generating past end-of-generation tokens, to `max_tokens` (default off; for
+    /// fixed-length throughput measurements like llama-bench's).
+    pub ignore_eos: bool,
 }
 
 impl LlamaCppConfig {
@@ -87,6 +90,7 @@ impl LlamaCppConfig {
             chat_template: None,
             prefix_cache: true,
             n_slots: 4,
+            ignore_eos: false,
         }
     }
 }
@@ -641,7 +645,7 @@ impl Worker<'_> {
             // `sample` also accepts the token into every sampler of the chain (grammar
             // included); accepting it again would corrupt the grammar state.
             let tok = sampler.sample(&self.ctx, last_idx);
-            if vocab.is_eog(tok) {
+            if !self.cfg.ignore_eos && vocab.is_eog(tok) {
                 break FinishReason::Stop;
             }
             n_gen += 1;
