@@ -230,3 +230,14 @@ fn picks_nothing_uses_are_reported() {
     assert_eq!(f[0].pos.map(|p| p.line), Some(1));
     assert!(f[0].message.contains("`chair` is picked but never used"));
 }
+
+#[test]
+fn deterministic_goto_plans_read_second_nearest_as_the_default_order() {
+    let map = flat_a();
+    let t = vec![Tuple::new("chair", Some(2), Some("red"))];
+    let s = simple_goto_script("go to the second nearest red chair", &t, Some(&map)).unwrap();
+    assert!(
+        s.contains("get_obj_attributes(\"chair\", 2, \"red\")"),
+        "{s}"
+    );
+}

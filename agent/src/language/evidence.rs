@@ -145,6 +145,14 @@ pub fn missing_evidence(instruction: &str, tuples: &[Tuple]) -> Vec<String> {
             }
         }
     }
+    for t in tuples {
+        if map_core::is_colour_word(&t.object) {
+            out.push(format!(
+                "\"{}\" is a colour, not an object: write the object it describes, with {} as its colour",
+                t.object, t.object
+            ));
+        }
+    }
     // Counting phrases: "from the west", "from west to east".
     let mut seen_orders: Vec<String> = Vec::new();
     for i in 0..w.len() {

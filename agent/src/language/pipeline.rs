@@ -335,7 +335,10 @@ pub fn extract_tuples_with(
             let again = backend.complete(&req)?;
             timing.add(&again);
             if let Ok(t2) = parse_tuples(&again.text) {
-                if missing_evidence(instruction, &t2).len() < missing.len() {
+                // A shorter list "misses less" by dropping mentions: not a correction.
+                if t2.len() >= tuples.len()
+                    && missing_evidence(instruction, &t2).len() < missing.len()
+                {
                     tuples = t2;
                 }
             }
@@ -457,6 +460,10 @@ pub fn simple_goto_script(
         let mut noun: Vec<&str> = Vec::new();
         for w in rest.split_whitespace() {
             if matches!(w, "the" | "a" | "an") && noun.is_empty() {
+                continue;
+            }
+            if noun.is_empty() && ordinal.is_some() && matches!(w, "nearest" | "closest") {
+                // "the second nearest": the default order, already counted.
                 continue;
             }
             if noun.is_empty() && ordinal.is_none() && colour.is_none() {

@@ -328,6 +328,16 @@ fn tuple_from_fields(fields: &[String], index: usize) -> Result<Tuple, TuplePars
     if object_n.is_empty() || is_null_word(&object_n) {
         return Err(bad("the object name is empty".into()));
     }
+    // "red chair" with the colour field red (or None): the model restated the colour in
+    // the name. A name that is only a colour word stays, for the checks to report.
+    let mut object_n = object_n;
+    let mut glued_colour: Option<String> = None;
+    if let Some((first, rest)) = object_n.split_once(' ') {
+        if map_core::is_colour_word(first) && !rest.trim().is_empty() {
+            glued_colour = normalise_colour(first);
+            object_n = rest.trim().to_string();
+        }
+    }
     let (ordinal, implied) = match fields.get(1) {
         Some(f) => parse_ordinal_with_order(&clean_field(f)).map_err(bad)?,
         None => (None, None),
@@ -345,6 +355,9 @@ fn tuple_from_fields(fields: &[String], index: usize) -> Result<Tuple, TuplePars
         _ => None,
     }
     .filter(|o| !o.is_empty());
+    if colour.is_none() {
+        colour = glued_colour;
+    }
     // A direction written where the colour goes ("from the west" as a colour).
     if let Some(c) = colour.clone() {
         if !map_core::is_colour_word(&c) {
@@ -646,6 +659,16 @@ mod tests {
         .unwrap();
         assert_eq!(json[0].order.as_deref(), Some("left_to_right"));
         assert!(parse_tuples("[(chair, 2, None, sideways)]").is_err());
+    }
+
+    #[test]
+    fn a_colour_glued_to_the_object_moves_to_the_colour_field() {
+        let got =
+            parse_tuples("[(red chair, 1, red), (white chair, None, None), (red, None, red)]")
+                .unwrap();
+        assert_eq!(got[0], Tuple::new("chair", Some(1), Some("red")));
+        assert_eq!(got[1], Tuple::new("chair", None, Some("white")));
+        assert_eq!(got[2].object, "red", "kept for the checks to report");
     }
 
     #[test]
