@@ -8,12 +8,14 @@
 //! | kind | what a real stack gets wrong | what is done |
 //! |---|---|---|
 //! | `label_flip` | LSeg/CLIP pixels of an object read as a similar category | each object cell (label not in `background`) takes, with this probability, its category's *confusion partner* (one other object category per category, drawn per map; the background label when there is no other) |
-//! | `fragment` | SAM splits one object into two masks | `round(rate * n)` masks are cut in two across their longer side, at 30..70% of it; the far part becomes a new mask |
-//! | `merge` | SAM covers two neighbours with one mask | `round(rate * n)` masks absorb the nearest other mask of the same category whose centroid lies within `merge_radius_m` |
-//! | `drop` | SAM misses an object | `round(rate * n)` masks are removed |
-//! | `colour_shift` | lighting and white balance change an object's colour | `round(rate * n)` objects have every RGB pixel shifted: chromatic pixels turn by 60..180 degrees of CIELAB hue (either way), achromatic ones (chroma < 12) move 35..55 in lightness L* (darker when light, lighter when dark) |
+//! | `fragment` | SAM splits one object into two masks | `rate * n` masks are cut in two across their longer side, at 30..70% of it; the far part becomes a new mask |
+//! | `merge` | SAM covers two neighbours with one mask | `rate * n` masks absorb the nearest other mask of the same category whose centroid lies within `merge_radius_m` |
+//! | `drop` | SAM misses an object | `rate * n` masks are removed |
+//! | `colour_shift` | lighting and white balance change an object's colour | `rate * n` objects have every RGB pixel shifted: chromatic pixels turn by 60..180 degrees of CIELAB hue (either way), achromatic ones (chroma < 12) move 35..55 in lightness L* (darker when light, lighter when dark) |
 //!
-//! `n` is the number of input masks. Each kind draws from its own random stream
+//! `n` is the number of input masks; a count `rate * n` that is not whole is rounded
+//! up with probability its fraction (so 0.05 of 30 masks is 1 or 2, 1.5 on average),
+//! down otherwise. Each kind draws from its own random stream
 //! (fastrand's wyrand seeded with `seed` and the kind), and the masks a kind picks
 //! are a prefix of one seeded permutation, so for a fixed seed a higher rate
 //! corrupts a superset of what a lower rate does (common random numbers: curves over
@@ -30,7 +32,7 @@
 //! let scene = Scene::from_path(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/office-b.scene.json")).unwrap();
 //! let clean = PerceptionInputs::from_scene(&scene);
 //! let (noisy, log) = clean.with_noise(&PerceptionNoise::uniform(0.1, 7)).unwrap();
-//! assert_eq!(log.dropped.len(), 3); // round(0.1 * 30 masks)
+//! assert_eq!(log.dropped.len(), 3); // 0.1 * 30 masks
 //! let built = IvlMap::from_perception(&noisy, &BuildConfig::default()).unwrap();
 //! assert!(built.map.instances.len() < clean.masks.len() + log.fragmented.len());
 //! // Same seed, same corruption.
@@ -160,9 +162,13 @@ fn rng(seed: u64, stream: u64) -> fastrand::Rng {
     fastrand::Rng::with_seed(seed ^ stream.rotate_left(17))
 }
 
-/// `round(rate * n)`, at most `n`.
-fn count(rate: f64, n: usize) -> usize {
-    ((rate * n as f64).round() as usize).min(n)
+/// `rate * n` rounded stochastically (down, or up with probability its fraction,
+/// so its mean is `rate * n` exactly), at most `n`. One draw whatever the rate, so
+/// the stream lines up across rates.
+fn count(rate: f64, n: usize, r: &mut fastrand::Rng) -> usize {
+    let u = r.f64();
+    // `as` saturates; rate * n is finite and >= 0
+    ((rate * n as f64 + u).floor() as usize).min(n)
 }
 
 impl PerceptionInputs {
@@ -216,10 +222,11 @@ impl PerceptionInputs {
 
         // Drop.
         let mut r = rng(noise.seed, STREAM_DROP);
+        let k_drop = count(noise.drop, n, &mut r);
         let mut order: Vec<usize> = (0..n).collect();
         r.shuffle(&mut order);
         let mut gone = vec![false; n];
-        for &i in order.iter().take(count(noise.drop, n)) {
+        for &i in order.iter().take(k_drop) {
             gone[i] = true;
             log.dropped.push(i);
         }
@@ -227,11 +234,12 @@ impl PerceptionInputs {
 
         // Merge: the picked mask absorbs its nearest same-category neighbour.
         let mut r = rng(noise.seed, STREAM_MERGE);
+        let k_merge = count(noise.merge, n, &mut r);
         let mut order: Vec<usize> = (0..n).collect();
         r.shuffle(&mut order);
         let mut merged_into: Vec<Vec<usize>> = vec![Vec::new(); n];
         let mut touched = vec![false; n];
-        for &i in order.iter().take(count(noise.merge, n)) {
+        for &i in order.iter().take(k_merge) {
             if gone[i] || touched[i] {
                 continue;
             }
@@ -254,11 +262,12 @@ impl PerceptionInputs {
 
         // Fragment among the masks neither dropped nor merged.
         let mut r = rng(noise.seed, STREAM_FRAGMENT);
+        let k_fragment = count(noise.fragment, n, &mut r);
         let mut order: Vec<usize> = (0..n).collect();
         r.shuffle(&mut order);
         let mut far_part: Vec<Option<Mask>> = vec![None; n];
         let mut near_part: Vec<Option<Mask>> = vec![None; n];
-        for &i in order.iter().take(count(noise.fragment, n)) {
+        for &i in order.iter().take(k_fragment) {
             let cut = r.f64() * 0.4 + 0.3;
             if gone[i] || touched[i] {
                 continue;
@@ -324,9 +333,10 @@ impl PerceptionInputs {
         // Colour shifts on the RGB under the original masks.
         let mut rgb = self.rgb.clone();
         let mut r = rng(noise.seed, STREAM_COLOUR);
+        let k_colour_shift = count(noise.colour_shift, n, &mut r);
         let mut order: Vec<usize> = (0..n).collect();
         r.shuffle(&mut order);
-        for &i in order.iter().take(count(noise.colour_shift, n)) {
+        for &i in order.iter().take(k_colour_shift) {
             let turn = (r.f64() * 120.0 + 60.0) * if r.bool() { 1.0 } else { -1.0 };
             let lift = r.f64() * 20.0 + 35.0;
             if let Some(g) = rgb.as_mut() {
