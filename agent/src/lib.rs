@@ -39,9 +39,9 @@ pub use eval::{
 };
 pub use language::{
     align_script, check_script, extract_code, extract_tuples, extract_tuples_with, library_calls,
-    normalise_colour, normalise_object, normalise_order, parse_ordinal, parse_ordinal_with_order,
-    parse_tuples, plan_instruction, pythonic_fixups, same_tuples, scene_summary,
-    simple_goto_script, tuple_grammar, tuples_paper_form, Arg, Finding, FindingKind, Fix,
-    LanguageError, LibCall, Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction, Pos,
-    PromptError, Prompts, Session, Timing, Tuple, TupleParseError, Turn, TEMPLATE_NAMES,
+    missing_evidence, normalise_colour, normalise_object, normalise_order, parse_ordinal,
+    parse_ordinal_with_order, parse_tuples, plan_instruction, pythonic_fixups, same_tuples,
+    scene_summary, simple_goto_script, tuple_grammar, tuples_paper_form, Arg, Finding, FindingKind,
+    Fix, LanguageError, LibCall, Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction,
+    Pos, PromptError, Prompts, Session, Timing, Tuple, TupleParseError, Turn, TEMPLATE_NAMES,
 };
