@@ -15,9 +15,7 @@ use super::checks::check_script;
 use super::evidence::missing_evidence;
 use super::prompts::{PromptError, Prompts};
 use super::script::{extract_code, pythonic_fixups};
-use super::tuples::{
-    normalise_colour, normalise_object, parse_ordinal, parse_tuples, Tuple, TupleParseError,
-};
+use super::tuples::{normalise_colour, normalise_object, parse_tuples, Tuple, TupleParseError};
 
 /// Everything that can stop the language layer (a question or refusal is not an error: see
 /// [`Outcome`]).
