@@ -32,10 +32,15 @@ pub use cli::{
     render_map, run_mission, write_json, BackendChoice, Chat, ChatFlow, CliError, Mission,
     MissionReport, CHAT_HELP, DEFAULT_MODEL_FILE,
 };
+pub use cli::{map_build, MapBuildArgs, TOPDOWN_PNG};
 pub use eval::{
     load_extract_suite, load_nav_suite, nav_scores, percentile, reached, run_extract, run_nav,
     run_task, satisfies, summarise, summary_table, vlmap_script, CaseResult, ExtractCase, Method,
     NavScores, NavTask, Report, Subgoal, SuiteError, SuiteKind, Summary, SUCCESS_RADIUS_M,
+};
+pub use eval::{
+    noise_study, noise_study_cli, noise_table, reference_tuples, NoiseEffects, NoiseRow,
+    NoiseStudy, NoiseStudyArgs, NoiseStudyOptions, NOISE_KINDS,
 };
 pub use language::{
     align_script, check_script, extract_code, extract_tuples, extract_tuples_with, library_calls,

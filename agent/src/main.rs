@@ -104,6 +104,9 @@ enum Command {
         #[command(subcommand)]
         command: MapCommand,
     },
+    /// Navigation under simulated perception noise: reference plans (ivlmap) and the
+    /// VLMaps baseline on maps built from corrupted perception, scored on the true scene.
+    NoiseStudy(agent::NoiseStudyArgs),
 }
 
 #[derive(Debug, Subcommand)]
@@ -132,6 +135,9 @@ enum MapCommand {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Build a map folder from perception outputs (SAM masks + label map), an RGB-D
+    /// dataset or a VLMaps map, and print what was kept and dropped.
+    Build(Box<agent::MapBuildArgs>),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -308,6 +314,7 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             )
         }
         Command::Map { command } => map_cmd(command),
+        Command::NoiseStudy(args) => agent::noise_study_cli(&args).map(|()| ExitCode::SUCCESS),
     }
 }
 
@@ -642,6 +649,7 @@ fn map_cmd(cmd: MapCommand) -> Result<ExitCode, CliError> {
             render_map(&m, t.as_ref(), &out)?;
             println!("wrote {}", out.display());
         }
+        MapCommand::Build(args) => agent::map_build(&args)?,
         MapCommand::Save { scene, out } => {
             let m = load_map(&scene)?;
             m.save(&out).map_err(|e| CliError::output(&out, e))?;

@@ -4,6 +4,7 @@
 
 mod backend;
 mod chat;
+mod mapbuild;
 mod mapinfo;
 mod mission;
 
@@ -11,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 pub use backend::{default_model_path, open_backend, BackendChoice, DEFAULT_MODEL_FILE};
 pub use chat::{Chat, ChatFlow, CHAT_HELP};
+pub use mapbuild::{map_build, MapBuildArgs, TOPDOWN_PNG};
 pub use mapinfo::{inspect_table, load_map, overlay_stops, render_map};
 pub use mission::{load_mission, run_mission, Mission, MissionReport};
 

@@ -7,6 +7,7 @@
 //!   the task's start pose; [`reached`] scores the stops; [`Report`] holds T_1..T_K and SR.
 
 mod baseline;
+mod noise;
 mod report;
 mod score;
 mod suite;
@@ -24,6 +25,10 @@ use crate::language::{
 };
 
 pub use baseline::vlmap_script;
+pub use noise::{
+    noise_study, noise_study_cli, noise_table, reference_tuples, NoiseEffects, NoiseRow,
+    NoiseStudy, NoiseStudyArgs, NoiseStudyOptions, NOISE_KINDS,
+};
 pub use report::{percentile, summarise, summary_table, CaseResult, Report, Summary};
 pub use score::{nav_scores, reached, satisfies, NavScores, SUCCESS_RADIUS_M};
 pub use suite::{
