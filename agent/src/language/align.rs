@@ -28,7 +28,7 @@ use map_core::{canonical, IvlMap, ObjectOrder};
 use planner_dsl::ParamType;
 use serde::Serialize;
 
-use super::checks::{library_calls, Arg, LibCall, Pos};
+use super::checks::{is_region_only, library_calls, Arg, LibCall, Pos};
 use super::tuples::Tuple;
 
 /// One rewrite made by [`align_script`].
@@ -164,13 +164,6 @@ fn call_span(src: &str, call: &LibCall, spelled: &[&str]) -> Option<(usize, usiz
         .strip_suffix("agent.")
         .map_or(name_at, |p| p.len());
     Some((start, open, end))
-}
-
-fn is_region_only(map: &IvlMap, name: &str) -> bool {
-    map.find_region(name).is_ok()
-        && map
-            .get_obj_attributes(name, 0, None, ObjectOrder::NearToFar, map.start_pose)
-            .is_err()
 }
 
 /// Rewrites the object picks of `src` to agree with `tuples` (see the module docs). The

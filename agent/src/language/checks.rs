@@ -166,6 +166,14 @@ fn is_region(map: &IvlMap, name: &str) -> bool {
     map.find_region(name).is_ok()
 }
 
+/// Whether `name` names a region and no object: a room to go to, not to pick.
+pub(crate) fn is_region_only(map: &IvlMap, name: &str) -> bool {
+    is_region(map, name)
+        && map
+            .get_obj_attributes(name, 0, None, ObjectOrder::NearToFar, map.start_pose)
+            .is_err()
+}
+
 fn tuple_text(t: &Tuple) -> String {
     let k = match t.ordinal {
         None => "no ordinal".to_string(),
@@ -329,10 +337,7 @@ pub fn check_script(
             }
             // The map.
             if let (Some(m), Some(k), Some(c), Some(o)) = (map, k, &colour, order) {
-                let region_only = is_region(m, name)
-                    && m.get_obj_attributes(name, 0, None, ObjectOrder::NearToFar, m.start_pose)
-                        .is_err();
-                if region_only {
+                if is_region_only(m, name) {
                     out.push(Finding {
                         pos: at,
                         kind: FindingKind::Map,

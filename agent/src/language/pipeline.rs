@@ -11,7 +11,7 @@ use serde::Serialize;
 use crate::backend::{ChatMessage, Completion, CompletionRequest, LlmBackend, LlmError};
 
 use super::align::{align_script, Fix};
-use super::checks::check_script;
+use super::checks::{check_script, is_region_only};
 use super::evidence::missing_evidence;
 use super::prompts::{PromptError, Prompts};
 use super::script::{extract_code, pythonic_fixups};
@@ -497,11 +497,7 @@ pub fn simple_goto_script(
             return None;
         }
         let name = object.replace(['"', '\\'], "");
-        let is_region = map.is_some_and(|m| {
-            m.find_region(&name).is_ok()
-                && m.get_obj_attributes(&name, 0, None, ObjectOrder::NearToFar, m.start_pose)
-                    .is_err()
-        });
+        let is_region = map.is_some_and(|m| is_region_only(m, &name));
         if is_region {
             if ordinal.is_some() || colour.is_some() {
                 return None;
