@@ -43,10 +43,11 @@ pub use eval::{
     NoiseStudy, NoiseStudyArgs, NoiseStudyOptions, NOISE_KINDS,
 };
 pub use language::{
-    align_script, check_script, extract_code, extract_tuples, extract_tuples_with, library_calls,
-    missing_evidence, normalise_colour, normalise_object, normalise_order, parse_ordinal,
-    parse_ordinal_with_order, parse_tuples, plan_instruction, pythonic_fixups, same_tuples,
-    scene_summary, simple_goto_script, tuple_grammar, tuples_paper_form, Arg, Finding, FindingKind,
-    Fix, LanguageError, LibCall, Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction,
-    Pos, PromptError, Prompts, Session, Timing, Tuple, TupleParseError, Turn, TEMPLATE_NAMES,
+    align_script, check_script, extract_code, extract_tuples, extract_tuples_in,
+    extract_tuples_with, library_calls, missing_evidence, normalise_colour, normalise_object,
+    normalise_order, parse_ordinal, parse_ordinal_with_order, parse_tuples, plan_instruction,
+    pythonic_fixups, reconcile_tuples, same_tuples, scene_summary, simple_goto_script,
+    tuple_grammar, tuples_paper_form, Arg, Finding, FindingKind, Fix, LanguageError, Lexicon,
+    LibCall, Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction, Pos, PromptError,
+    Prompts, Session, Timing, Tuple, TupleFix, TupleParseError, Turn, TEMPLATE_NAMES,
 };

@@ -187,6 +187,10 @@ struct ModelArgs {
     /// calls of the function library.
     #[arg(long, value_enum, default_value_t = Grammar::Tuples)]
     grammar: Grammar,
+    /// Use step 1's tuples as the model wrote them: no re-ask on missed words and no
+    /// reconciliation with the instruction's words (measures the model alone).
+    #[arg(long)]
+    raw_tuples: bool,
 }
 
 /// Which steps decode under a GBNF grammar.
@@ -218,6 +222,8 @@ impl ModelArgs {
         PlanOptions {
             tuple_grammar: matches!(self.grammar, Grammar::Tuples | Grammar::Both),
             script_grammar: matches!(self.grammar, Grammar::Script | Grammar::Both),
+            tuple_check: !self.raw_tuples,
+            reconcile: !self.raw_tuples,
             ..PlanOptions::default()
         }
     }

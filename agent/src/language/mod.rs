@@ -3,6 +3,7 @@
 //! - [`prompts`]: prompt templates (files in `prompts/`, variants overlay them).
 //! - [`tuples`]: step 1's answer format, parsing and normalisation.
 //! - [`script`]: the code block in step 2's answer, and Python-ism fixups.
+//! - [`reconcile`]: step 1's tuples against the instruction's own words.
 //! - [`checks`]: agreement between the script, the tuples and the map.
 //! - [`pipeline`]: [`extract_tuples`], [`plan_instruction`] (resolution against the map,
 //!   deterministic plans for plain "go to X" sequences, the LLM path with a bounded repair
@@ -15,6 +16,7 @@ mod evidence;
 mod grammar;
 mod pipeline;
 mod prompts;
+mod reconcile;
 mod script;
 mod session;
 mod tuples;
@@ -24,10 +26,12 @@ pub use checks::{check_script, library_calls, Arg, Finding, FindingKind, LibCall
 pub use evidence::missing_evidence;
 pub use grammar::tuple_grammar;
 pub use pipeline::{
-    extract_tuples, extract_tuples_with, plan_instruction, scene_summary, simple_goto_script,
-    LanguageError, Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction, Timing,
+    extract_tuples, extract_tuples_in, extract_tuples_with, plan_instruction, scene_summary,
+    simple_goto_script, LanguageError, Outcome, PlanContext, PlanOptions, PlanSource,
+    PlannedInstruction, Timing,
 };
 pub use prompts::{PromptError, Prompts, TEMPLATE_NAMES};
+pub use reconcile::{reconcile_tuples, Lexicon, TupleFix};
 pub use script::{extract_code, pythonic_fixups};
 pub use session::{Session, Turn};
 pub use tuples::{

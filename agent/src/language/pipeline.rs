@@ -14,6 +14,7 @@ use super::align::{align_script, Fix};
 use super::checks::{check_script, is_region_only};
 use super::evidence::missing_evidence;
 use super::prompts::{PromptError, Prompts};
+use super::reconcile::{reconcile_tuples, Lexicon};
 use super::script::{extract_code, pythonic_fixups};
 use super::tuples::{normalise_colour, normalise_object, parse_tuples, Tuple, TupleParseError};
 
@@ -113,6 +114,10 @@ pub struct PlanOptions {
     /// colour words and ask once more when they miss some (default on; see
     /// [`crate::missing_evidence`]).
     pub tuple_check: bool,
+    /// Reconcile step 1's tuples with the instruction's words: one tuple per mention in
+    /// order of mention, ordinals, colours and orders as the words say (default on; see
+    /// [`crate::reconcile_tuples`]). Off, the model's tuples are used as it wrote them.
+    pub reconcile: bool,
     /// Constrain step 2's scripts with [`planner_dsl::script_grammar`] (default off: see
     /// README, "Grammars", for what it costs and changes).
     pub script_grammar: bool,
@@ -129,6 +134,7 @@ impl Default for PlanOptions {
             scene_in_extract: false,
             tuple_grammar: true,
             tuple_check: true,
+            reconcile: true,
             script_grammar: false,
         }
     }
@@ -290,7 +296,8 @@ pub fn extract_tuples(
     )
 }
 
-/// Step 1 with explicit options (token budget, tuple grammar).
+/// Step 1 with explicit options (token budget, tuple grammar), names reconciled against
+/// the built-in [`Lexicon`].
 ///
 /// # Errors
 /// As [`extract_tuples`].
@@ -301,7 +308,41 @@ pub fn extract_tuples_with(
     scene_ctx: Option<&str>,
     options: &PlanOptions,
 ) -> Result<(Vec<Tuple>, Timing), LanguageError> {
+    extract_tuples_in(
+        backend,
+        prompts,
+        instruction,
+        scene_ctx,
+        options,
+        &Lexicon::builtin(),
+    )
+}
+
+/// Step 1 with explicit options, reconciling the model's tuples with the instruction's
+/// words (when [`PlanOptions::reconcile`]) using `lexicon` for mentions the model left
+/// out ([`Lexicon::for_map`] when planning on a map).
+///
+/// # Errors
+/// As [`extract_tuples`].
+pub fn extract_tuples_in(
+    backend: &dyn LlmBackend,
+    prompts: &Prompts,
+    instruction: &str,
+    scene_ctx: Option<&str>,
+    options: &PlanOptions,
+    lexicon: &Lexicon,
+) -> Result<(Vec<Tuple>, Timing), LanguageError> {
     let t0 = Instant::now();
+    let settle = |tuples: Vec<Tuple>| {
+        if !options.reconcile {
+            return tuples;
+        }
+        let (tuples, fixes) = reconcile_tuples(instruction, &tuples, lexicon);
+        for f in &fixes {
+            tracing::debug!(fix = %f, "step 1 reconciled with the instruction's words");
+        }
+        tuples
+    };
     let mut req = CompletionRequest::new(
         prompts.extract_messages(instruction, scene_ctx)?,
         options.extract_max_tokens,
@@ -313,10 +354,12 @@ pub fn extract_tuples_with(
     let c = backend.complete(&req)?;
     let mut timing = Timing::default();
     timing.add(&c);
-    let mut tuples = parse_tuples(&c.text).map_err(|source| LanguageError::Tuples {
-        source,
-        answer: c.text.clone(),
-    })?;
+    let mut tuples = settle(
+        parse_tuples(&c.text).map_err(|source| LanguageError::Tuples {
+            source,
+            answer: c.text.clone(),
+        })?,
+    );
     if options.tuple_check {
         let missing = missing_evidence(instruction, &tuples);
         if !missing.is_empty() {
@@ -332,7 +375,7 @@ pub fn extract_tuples_with(
             )));
             let again = backend.complete(&req)?;
             timing.add(&again);
-            if let Ok(t2) = parse_tuples(&again.text) {
+            if let Ok(t2) = parse_tuples(&again.text).map(settle) {
                 // A shorter list "misses less" by dropping mentions: not a correction.
                 if t2.len() >= tuples.len()
                     && missing_evidence(instruction, &t2).len() < missing.len()
@@ -642,8 +685,14 @@ pub fn plan_instruction(
     let t0 = Instant::now();
     let scene = scene_summary(ctx.map);
     let extract_scene = ctx.options.scene_in_extract.then_some(scene.as_str());
-    let (tuples, t1) =
-        extract_tuples_with(backend, prompts, instruction, extract_scene, &ctx.options)?;
+    let (tuples, t1) = extract_tuples_in(
+        backend,
+        prompts,
+        instruction,
+        extract_scene,
+        &ctx.options,
+        &Lexicon::for_map(ctx.map),
+    )?;
     if let Some(o) = resolve(&tuples, ctx.map, ctx.pose()) {
         return Ok(o);
     }
