@@ -168,10 +168,19 @@ fn deterministic_goto_plans_only_when_words_agree() {
         simple_goto_script("go to the second red chair", &wrong, Some(&map)),
         None
     );
-    // Spatial words: not a plain go-to.
+    // A side of the object is its own call.
     let one = vec![Tuple::new("sofa", None, Some("red"))];
     assert_eq!(
-        simple_goto_script("go to the left of the red sofa", &one, Some(&map)),
+        simple_goto_script("go to the left of the red sofa", &one, Some(&map)).unwrap(),
+        "let target_1 = agent.get_obj_attributes(\"sofa\", 0, \"red\");\nagent.move_to_left(target_1);\n"
+    );
+    // A relation the table does not hold is left to the LLM.
+    let two = vec![
+        Tuple::new("chair", None, None),
+        Tuple::new("desk", None, None),
+    ];
+    assert_eq!(
+        simple_goto_script("go to the chair next to the desk", &two, Some(&map)),
         None
     );
     assert!(simple_goto_script("go to the red sofa", &one, Some(&map)).is_some());
@@ -211,6 +220,47 @@ fn deterministic_goto_plans_read_orders_superlatives_and_verbless_clauses() {
     let one = vec![Tuple::new("chair", None, None)];
     assert_eq!(
         simple_goto_script("go to the chair from yesterday", &one, Some(&map)),
+        None
+    );
+}
+
+#[test]
+fn deterministic_plans_for_sides_between_and_face() {
+    let map = flat_a();
+    let t = vec![
+        Tuple::new("sofa", None, Some("black")),
+        Tuple::new("table", None, Some("black")),
+        Tuple::new("sofa", None, Some("red")),
+        Tuple::new("chair", None, Some("gray")),
+        Tuple::new("tv", None, None),
+    ];
+    let s = simple_goto_script(
+        "stop on the left of the black sofa, then go in between the black table and the red sofa, then to the north side of the grey chair and face the tv",
+        &t,
+        Some(&map),
+    )
+    .unwrap();
+    assert_eq!(
+        s,
+        "let target_1 = agent.get_obj_attributes(\"sofa\", 0, \"black\");\nagent.move_to_left(target_1);\n\
+         let target_2 = agent.get_obj_attributes(\"table\", 0, \"black\");\nlet target_3 = agent.get_obj_attributes(\"sofa\", 0, \"red\");\nagent.move_in_between(target_2, target_3);\n\
+         let target_4 = agent.get_obj_attributes(\"chair\", 0, \"gray\");\nagent.move_north(target_4);\n\
+         let target_5 = agent.get_obj_attributes(\"tv\", 0, \"\");\nagent.face(target_5);\n"
+    );
+    assert!(planner_dsl::Plan::compile(&s).is_ok());
+    // A side of a room has no single reading: left to the LLM.
+    let room = vec![Tuple::new("kitchen", None, None)];
+    assert_eq!(
+        simple_goto_script("go to the north side of the kitchen", &room, Some(&map)),
+        None
+    );
+    // Fewer tuples than noun phrases: no template.
+    assert_eq!(
+        simple_goto_script(
+            "go between the black table and the red sofa",
+            &t[1..2],
+            Some(&map)
+        ),
         None
     );
 }

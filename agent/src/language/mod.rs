@@ -19,6 +19,7 @@ mod prompts;
 mod reconcile;
 mod script;
 mod session;
+mod template;
 mod tuples;
 
 pub use align::{align_script, Fix};
@@ -27,13 +28,13 @@ pub use evidence::missing_evidence;
 pub use grammar::tuple_grammar;
 pub use pipeline::{
     extract_tuples, extract_tuples_in, extract_tuples_with, plan_instruction, scene_summary,
-    simple_goto_script, LanguageError, Outcome, PlanContext, PlanOptions, PlanSource,
-    PlannedInstruction, Timing,
+    LanguageError, Outcome, PlanContext, PlanOptions, PlanSource, PlannedInstruction, Timing,
 };
 pub use prompts::{PromptError, Prompts, TEMPLATE_NAMES};
 pub use reconcile::{reconcile_tuples, Lexicon, TupleFix};
 pub use script::{extract_code, pythonic_fixups};
 pub use session::{Session, Turn};
+pub use template::simple_goto_script;
 pub use tuples::{
     normalise_colour, normalise_object, normalise_order, parse_ordinal, parse_ordinal_with_order,
     parse_tuples, same_tuples, tuples_paper_form, Tuple, TupleParseError,

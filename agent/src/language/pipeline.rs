@@ -4,19 +4,20 @@
 
 use std::time::Instant;
 
-use map_core::{IvlMap, ObjectOrder, Pose, QueryError, SimRobot};
+use map_core::{IvlMap, Pose, QueryError, SimRobot};
 use planner_dsl::{Limits, Plan, PlanError};
 use serde::Serialize;
 
 use crate::backend::{ChatMessage, Completion, CompletionRequest, LlmBackend, LlmError};
 
 use super::align::{align_script, Fix};
-use super::checks::{check_script, is_region_only};
+use super::checks::check_script;
 use super::evidence::missing_evidence;
 use super::prompts::{PromptError, Prompts};
 use super::reconcile::{reconcile_tuples, Lexicon};
 use super::script::{extract_code, pythonic_fixups};
-use super::tuples::{normalise_colour, normalise_object, parse_tuples, Tuple, TupleParseError};
+use super::template::simple_goto_script;
+use super::tuples::{parse_tuples, Tuple, TupleParseError};
 
 /// Everything that can stop the language layer (a question or refusal is not an error: see
 /// [`Outcome`]).
@@ -412,181 +413,6 @@ fn resolve(tuples: &[Tuple], map: &IvlMap, pose: Pose) -> Option<Outcome> {
         }
     }
     None
-}
-
-const GOTO_PREFIXES: &[&str] = &[
-    "go over to ",
-    "go to ",
-    "go into ",
-    "go in to ",
-    "navigate to ",
-    "move to ",
-    "move over to ",
-    "walk to ",
-    "walk over to ",
-    "walk into ",
-    "head to ",
-    "head over to ",
-    "head into ",
-    "drive to ",
-    "proceed to ",
-    "travel to ",
-    "get to ",
-    "visit ",
-    "reach ",
-    "enter ",
-];
-
-const SEPARATORS: &[&str] = &[
-    ", and then ",
-    ", then ",
-    " and then ",
-    " then ",
-    ", and ",
-    " and ",
-    "; ",
-    ", ",
-    ". ",
-];
-
-/// A script for a plain sequence of "go to X" clauses, written from the tuples without the
-/// LLM: `None` unless every clause is "go to [ordinal] [colour] object" and its words agree
-/// exactly with the tuple of the same position (so a tuple the extractor got wrong falls
-/// back to the LLM path and its checks).
-#[must_use]
-pub fn simple_goto_script(
-    instruction: &str,
-    tuples: &[Tuple],
-    map: Option<&IvlMap>,
-) -> Option<String> {
-    if tuples.is_empty() {
-        return None;
-    }
-    let mut text = instruction.trim().to_lowercase();
-    while text.ends_with(['.', '!', '?']) {
-        text.pop();
-    }
-    for sep in SEPARATORS {
-        text = text.replace(sep, "|");
-    }
-    let clauses: Vec<&str> = text
-        .split('|')
-        .map(str::trim)
-        .filter(|c| !c.is_empty())
-        .collect();
-    if clauses.len() != tuples.len() {
-        return None;
-    }
-    let mut script = String::new();
-    for (i, (clause, t)) in clauses.iter().zip(tuples).enumerate() {
-        let mut c = *clause;
-        for lead in [
-            "please ", "then ", "and ", "next ", "finally ", "now ", "first ",
-        ] {
-            c = c.strip_prefix(lead).unwrap_or(c);
-        }
-        // "go to A, then B, then to C": later clauses may leave the verb out.
-        let rest = match GOTO_PREFIXES.iter().find_map(|p| c.strip_prefix(p)) {
-            Some(r) => r,
-            None if i > 0 => ["to ", "into ", ""]
-                .iter()
-                .find_map(|p| c.strip_prefix(p))
-                .filter(|r| r.starts_with("the ") || r.starts_with("a "))?,
-            None => return None,
-        };
-        let (rest, trailing_order) = strip_trailing_qualifier(rest)?;
-        let mut ordinal: Option<i64> = None;
-        let mut order: Option<String> = trailing_order;
-        let mut colour: Option<String> = None;
-        let mut noun: Vec<&str> = Vec::new();
-        for w in rest.split_whitespace() {
-            if matches!(w, "the" | "a" | "an") && noun.is_empty() {
-                continue;
-            }
-            if noun.is_empty() && ordinal.is_some() && matches!(w, "nearest" | "closest") {
-                // "the second nearest": the default order, already counted.
-                continue;
-            }
-            if noun.is_empty() && ordinal.is_none() && colour.is_none() {
-                if let Ok((k, o)) = super::tuples::parse_ordinal_with_order(w) {
-                    // "nearest"/"closest" read as unspecified.
-                    if k.is_some() || matches!(w, "nearest" | "closest") {
-                        ordinal = k;
-                        if o.is_some() {
-                            if order.is_some() {
-                                return None;
-                            }
-                            order = o;
-                        }
-                        continue;
-                    }
-                }
-            }
-            if noun.is_empty() && colour.is_none() && map_core::is_colour_word(w) {
-                colour = normalise_colour(w);
-                continue;
-            }
-            if !w.chars().all(|ch| ch.is_alphabetic() || ch == '-') {
-                return None;
-            }
-            noun.push(w);
-        }
-        if noun.is_empty() || noun.len() > 3 {
-            return None;
-        }
-        let object = normalise_object(&noun.join(" "));
-        let mine = Tuple::new(&object, ordinal, colour.as_deref()).with_order(order.as_deref());
-        if object != t.object || ordinal != t.ordinal || colour != t.colour || !mine.same_order(t) {
-            return None;
-        }
-        let name = object.replace(['"', '\\'], "");
-        let is_region = map.is_some_and(|m| is_region_only(m, &name));
-        if is_region {
-            if ordinal.is_some() || colour.is_some() {
-                return None;
-            }
-            script.push_str(&format!("agent.move_to_object(\"{name}\");\n"));
-        } else {
-            let v = format!("target_{}", i + 1);
-            let order = match t.object_order() {
-                ObjectOrder::NearToFar => String::new(),
-                o => format!(", \"{}\"", o.name()),
-            };
-            script.push_str(&format!(
-                "let {v} = agent.get_obj_attributes(\"{name}\", {}, \"{}\"{order});\nagent.move_to_object({v});\n",
-                ordinal.unwrap_or(0),
-                colour.as_deref().unwrap_or("")
-            ));
-        }
-    }
-    Some(script)
-}
-
-/// Splits a counting phrase off the end of a "go to" clause: "the second table from the
-/// west" -> ("the second table", west_to_east); "counting from west to east" likewise;
-/// "nearest to you" / "closest to you" / "nearest to it" (the default order: distances
-/// from where the robot is) are dropped. `None` when a trailing phrase is not understood
-/// ("the chair next to the desk" is for the LLM path).
-fn strip_trailing_qualifier(rest: &str) -> Option<(&str, Option<String>)> {
-    for q in [
-        " nearest to you",
-        " closest to you",
-        " nearest to it",
-        " closest to it",
-        " nearest to the robot",
-    ] {
-        if let Some(r) = rest.strip_suffix(q) {
-            return Some((r, None));
-        }
-    }
-    for lead in [" counting from ", " from "] {
-        if let Some(i) = rest.rfind(lead) {
-            let phrase = &rest[i + 1..];
-            let o = super::tuples::normalise_order(phrase)?;
-            return Some((&rest[..i], Some(o)));
-        }
-    }
-    Some((rest, None))
 }
 
 /// The source line `line` (1-based) of `src`, for quoting in feedback.

@@ -217,38 +217,40 @@ fn is_determiner(w: &str) -> bool {
     )
 }
 
-/// Words a model sometimes lists that name no object: directions, sides, motions.
+/// Words a model sometimes lists that name no object: directions, sides, motions, a
+/// colour on its own ("red" of "the red chair nearest to you").
 fn names_nothing(object: &str) -> bool {
-    object.split_whitespace().all(|w| {
-        matches!(
-            w,
-            "left"
-                | "right"
-                | "front"
-                | "back"
-                | "behind"
-                | "side"
-                | "turn"
-                | "around"
-                | "forward"
-                | "backward"
-                | "north"
-                | "south"
-                | "east"
-                | "west"
-                | "meter"
-                | "metre"
-                | "degree"
-                | "it"
-                | "them"
-                | "you"
-                | "me"
-                | "here"
-                | "there"
-                | "way"
-                | "direction"
-        ) || w.chars().all(|c| c.is_ascii_digit())
-    })
+    map_core::is_colour_word(object)
+        || object.split_whitespace().all(|w| {
+            matches!(
+                w,
+                "left"
+                    | "right"
+                    | "front"
+                    | "back"
+                    | "behind"
+                    | "side"
+                    | "turn"
+                    | "around"
+                    | "forward"
+                    | "backward"
+                    | "north"
+                    | "south"
+                    | "east"
+                    | "west"
+                    | "meter"
+                    | "metre"
+                    | "degree"
+                    | "it"
+                    | "them"
+                    | "you"
+                    | "me"
+                    | "here"
+                    | "there"
+                    | "way"
+                    | "direction"
+            ) || w.chars().all(|c| c.is_ascii_digit())
+        })
 }
 
 /// A mention of a name in the instruction: token range and its canonical name.
@@ -732,6 +734,16 @@ mod tests {
             &[t("tv", None, None), t("right", None, None)],
         );
         assert_eq!(got, vec![t("tv", None, None)]);
+        // A colour listed as an object: the noun it describes gets the tuple.
+        let got = run(
+            "go to the rightmost black chair, then the red chair nearest to you",
+            &[
+                t("chair", Some(1), Some("black")).with_order(Some("right_to_left")),
+                t("red", None, None),
+            ],
+        );
+        assert_eq!(got.len(), 2, "{got:?}");
+        assert_eq!(got[1], t("chair", None, Some("red")));
     }
 
     #[test]
