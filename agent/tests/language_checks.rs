@@ -282,6 +282,51 @@ fn picks_nothing_uses_are_reported() {
 }
 
 #[test]
+fn targets_picked_by_name_and_never_used_are_reported() {
+    let map = flat_a();
+    let t = vec![
+        Tuple::new("plant", None, None),
+        Tuple::new("kitchen", None, None),
+    ];
+    let f = check_script(
+        "let plant = agent.get_nearest_obj_pos(\"plant\");\nlet kitchen = \"kitchen\";\nagent.turn(90);",
+        &t,
+        Some(&map),
+    )
+    .unwrap();
+    let unused: Vec<_> = f
+        .iter()
+        .filter(|f| f.kind == FindingKind::Unused)
+        .map(|f| f.pos.map(|p| p.line))
+        .collect();
+    assert_eq!(unused, vec![Some(1), Some(2)], "{f:?}");
+}
+
+#[test]
+fn deterministic_plans_read_it_and_whichever_is_closest() {
+    let map = flat_a();
+    let t = vec![
+        Tuple::new("tv", None, None),
+        Tuple::new("plant", None, None),
+        Tuple::new("table", None, None),
+    ];
+    let s = simple_goto_script(
+        "head over to the tv and face it, then whichever plant is closest, then the table next to it",
+        &t,
+        Some(&map),
+    )
+    .unwrap();
+    assert_eq!(
+        s,
+        "let target_1 = agent.get_obj_attributes(\"tv\", 0, \"\");\nagent.move_to_object(target_1);\nagent.face(target_1);\n\
+         let target_2 = agent.get_obj_attributes(\"plant\", 0, \"\");\nagent.move_to_object(target_2);\n\
+         let target_3 = agent.get_obj_attributes(\"table\", 0, \"\");\nagent.move_to_object(target_3);\n"
+    );
+    // "it" before anything was named is not understood.
+    assert_eq!(simple_goto_script("face it", &t[..0], Some(&map)), None);
+}
+
+#[test]
 fn deterministic_goto_plans_read_second_nearest_as_the_default_order() {
     let map = flat_a();
     let t = vec![Tuple::new("chair", Some(2), Some("red"))];

@@ -217,6 +217,12 @@ impl NameMatcher for LexicalMatcher {
         if q.replace(' ', "") == l.replace(' ', "") {
             return 0.95;
         }
+        // A closed compound names its head: "armchair" a "chair", "bookshelf" a "shelf"
+        // (one way only: a chair need not be an armchair).
+        let last = q.rsplit(' ').next().unwrap_or(&q);
+        if !l.contains(' ') && l.len() >= 4 && last.len() > l.len() && last.ends_with(l.as_str()) {
+            return 0.78;
+        }
         0.0
     }
 }
@@ -224,6 +230,18 @@ impl NameMatcher for LexicalMatcher {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_closed_compound_names_its_head_one_way() {
+        let m = LexicalMatcher;
+        assert_eq!(m.best("armchair", &["sofa", "chair"]), Some("chair"));
+        assert_eq!(m.best("grey armchairs", &["chair"]), Some("chair"));
+        assert_eq!(m.best("chair", &["armchair"]), None);
+        // Exact names win over the compound rule.
+        assert_eq!(m.best("armchair", &["chair", "armchair"]), Some("armchair"));
+        // Short labels do not match word endings ("tv" in nothing, "bed" in "sofabed" is 3).
+        assert_eq!(m.best("sofabed", &["bed"]), None);
+    }
 
     #[test]
     fn plural_case_and_synonyms_match() {

@@ -330,6 +330,29 @@ fn pick_binding(line: &str) -> Option<&str> {
     .then_some(name)
 }
 
+/// `let x = agent.get_nearest_obj_pos("plant");` or `let x = "bathroom";`: a target
+/// that a plan picks to go to (a script that never uses it stops short).
+fn target_binding(line: &str) -> Option<&str> {
+    let rest = line.trim().strip_prefix("let ")?;
+    let (name, rhs) = rest.split_once('=')?;
+    let name = name.trim();
+    let rhs = rhs.trim();
+    let rhs = rhs.strip_prefix("agent.").unwrap_or(rhs);
+    let picks = [
+        "get_nearest_obj_pos",
+        "get_specifed_obj_pos",
+        "get_specified_obj_pos",
+    ]
+    .iter()
+    .any(|f| rhs.starts_with(f))
+        || (rhs.starts_with('"') && rhs.ends_with("\";") && rhs.len() > 3);
+    (picks
+        && rhs.ends_with(';')
+        && !name.is_empty()
+        && name.chars().all(|c| c.is_alphanumeric() || c == '_'))
+    .then_some(name)
+}
+
 fn mentions(line: &str, var: &str) -> bool {
     line.match_indices(var).any(|(i, _)| {
         let before = line[..i].chars().next_back();
@@ -345,7 +368,7 @@ pub(crate) fn unused_picks(src: &str) -> Vec<(usize, String)> {
     let lines: Vec<&str> = src.lines().collect();
     let mut out = Vec::new();
     for (i, l) in lines.iter().enumerate() {
-        if let Some(var) = pick_binding(l) {
+        if let Some(var) = pick_binding(l).or_else(|| target_binding(l)) {
             if !lines[i + 1..].iter().any(|later| mentions(later, var)) {
                 out.push((i + 1, var.to_string()));
             }

@@ -143,7 +143,9 @@ fn classify(c: &str, later: bool) -> Option<Action<'_>> {
         None if later => ["to ", "into ", ""]
             .iter()
             .find_map(|p| c.strip_prefix(p))
-            .filter(|r| r.starts_with("the ") || r.starts_with("a "))?,
+            .filter(|r| {
+                r.starts_with("the ") || r.starts_with("a ") || r.starts_with("whichever ")
+            })?,
         None => return None,
     };
     Some(Action::GoTo(rest))
@@ -151,6 +153,19 @@ fn classify(c: &str, later: bool) -> Option<Action<'_>> {
 
 /// "[the] [ordinal|superlative] [colour] noun [counting phrase]": the tuple its words say.
 fn read_noun_phrase(np: &str) -> Option<Tuple> {
+    // "whichever plant is closest": the nearest plant.
+    let np = match np.strip_prefix("whichever ") {
+        Some(r) => [
+            "is closest",
+            "is nearest",
+            "is the closest",
+            "is the nearest",
+        ]
+        .iter()
+        .find_map(|q| r.strip_suffix(q))?
+        .trim_end(),
+        None => np,
+    };
     let (rest, trailing_order) = strip_trailing_qualifier(np)?;
     let mut ordinal: Option<i64> = None;
     let mut order: Option<String> = trailing_order;
@@ -206,6 +221,10 @@ fn strip_trailing_qualifier(rest: &str) -> Option<(&str, Option<String>)> {
         " closest to you",
         " nearest to it",
         " closest to it",
+        " next to it",
+        " near it",
+        " beside it",
+        " by it",
         " nearest to the robot",
     ] {
         if let Some(r) = rest.strip_suffix(q) {
@@ -269,8 +288,13 @@ pub fn simple_goto_script(
     }
     let mut script = String::new();
     let mut next = 0usize;
-    // The variable for the next tuple, declared in `script`; regions only where allowed.
+    let mut last: Option<String> = None;
+    // The variable for the next tuple, declared in `script`; regions only where allowed;
+    // "it" is the object named last.
     let mut pick = |np: &str, script: &mut String, region_ok: bool| -> Option<String> {
+        if np == "it" {
+            return last.clone().filter(|v| !v.starts_with('"'));
+        }
         let t = tuples.get(next)?;
         let mine = read_noun_phrase(np)?;
         if mine.object != t.object
@@ -286,7 +310,9 @@ pub fn simple_goto_script(
             if !region_ok || t.ordinal.is_some() || t.colour.is_some() {
                 return None;
             }
-            return Some(format!("\"{name}\""));
+            let v = format!("\"{name}\"");
+            last = Some(v.clone());
+            return Some(v);
         }
         let v = format!("target_{next}");
         let order = match t.object_order() {
@@ -298,6 +324,7 @@ pub fn simple_goto_script(
             t.ordinal.unwrap_or(0),
             t.colour.as_deref().unwrap_or("")
         ));
+        last = Some(v.clone());
         Some(v)
     };
     for (i, clause) in clauses(instruction).iter().enumerate() {
