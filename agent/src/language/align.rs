@@ -330,8 +330,9 @@ fn pick_binding(line: &str) -> Option<&str> {
     .then_some(name)
 }
 
-/// `let x = agent.get_nearest_obj_pos("plant");` or `let x = "bathroom";`: a target
-/// that a plan picks to go to (a script that never uses it stops short).
+/// `let x = agent.get_nearest_obj_pos("plant");`: a target a plan picks to go to (a
+/// script that never uses it stops short). A bare region name (`let r = "kitchen";`) is
+/// not one: "the plant in the kitchen" names a room that nothing goes to.
 fn target_binding(line: &str) -> Option<&str> {
     let rest = line.trim().strip_prefix("let ")?;
     let (name, rhs) = rest.split_once('=')?;
@@ -344,8 +345,7 @@ fn target_binding(line: &str) -> Option<&str> {
         "get_specified_obj_pos",
     ]
     .iter()
-    .any(|f| rhs.starts_with(f))
-        || (rhs.starts_with('"') && rhs.ends_with("\";") && rhs.len() > 3);
+    .any(|f| rhs.starts_with(f));
     (picks
         && rhs.ends_with(';')
         && !name.is_empty()

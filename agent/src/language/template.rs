@@ -23,6 +23,27 @@ use super::tuples::{normalise_colour, normalise_object, parse_ordinal_with_order
 
 const GOTO_PREFIXES: &[&str] = &[
     "go over to ",
+    "go up to ",
+    "go back to ",
+    "drive up to ",
+    "drive over to ",
+    "walk up to ",
+    "make your way to ",
+    "take me to ",
+    "head for ",
+    "return to ",
+    "come to ",
+    "end up in ",
+    "end up at ",
+    "finish in ",
+    "finish up in ",
+    "wrap up in ",
+    "stop in ",
+    "stop at ",
+    "stop next to ",
+    "stop by ",
+    "park next to ",
+    "park by ",
     "go to ",
     "go into ",
     "go in to ",
@@ -140,7 +161,7 @@ fn classify(c: &str, later: bool) -> Option<Action<'_>> {
     // "go to A, then B, then to C": later clauses may leave the verb out.
     let rest = match GOTO_PREFIXES.iter().find_map(|p| c.strip_prefix(p)) {
         Some(r) => r,
-        None if later => ["to ", "into ", ""]
+        None if later => ["over to ", "on to ", "to ", "into ", ""]
             .iter()
             .find_map(|p| c.strip_prefix(p))
             .filter(|r| {
@@ -196,6 +217,10 @@ fn read_noun_phrase(np: &str) -> Option<Tuple> {
         }
         if noun.is_empty() && colour.is_none() && map_core::is_colour_word(w) {
             colour = normalise_colour(w);
+            continue;
+        }
+        // Sizes are not on the map: "the little table" is a table.
+        if noun.is_empty() && matches!(w, "little" | "small" | "big" | "large" | "tall" | "low") {
             continue;
         }
         if !w.chars().all(|ch| ch.is_alphabetic() || ch == '-') {
