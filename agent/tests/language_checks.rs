@@ -328,6 +328,50 @@ fn deterministic_plans_read_it_and_whichever_is_closest() {
 }
 
 #[test]
+fn deterministic_plans_pick_an_object_in_a_room() {
+    let map = flat_a();
+    let t = vec![
+        Tuple::new("plant", None, None),
+        Tuple::new("office", None, None),
+        Tuple::new("chair", Some(2), Some("black")),
+        Tuple::new("dining room", None, None),
+    ];
+    let s = simple_goto_script(
+        "go to the plant in the office, then the second black chair in the dining room",
+        &t,
+        Some(&map),
+    )
+    .unwrap();
+    assert_eq!(
+        s,
+        "let target_2 = agent.get_obj_in_region(\"plant\", \"office\", 0, \"\");\nagent.move_to_object(target_2);\n\
+         let target_4 = agent.get_obj_in_region(\"chair\", \"dining room\", 2, \"black\");\nagent.move_to_object(target_4);\n"
+    );
+    let f = check_script(&s, &t, Some(&map)).unwrap();
+    assert!(f.is_empty(), "{f:?}");
+    // Alignment leaves its names alone.
+    let (aligned, fixes) = agent::align_script(&s, &t, Some(&map));
+    assert_eq!((aligned.as_str(), fixes.len()), (s.as_str(), 0));
+    // The plan runs and stops at the office's plant (id 30), not the nearer ones.
+    let plan = planner_dsl::Plan::compile(&s).unwrap();
+    let map = std::sync::Arc::new(map);
+    let mut robot = map_core::SimRobot::new(map.clone());
+    let out = planner_dsl::run(&plan, &map, &mut robot, &planner_dsl::Limits::default());
+    assert!(out.error.is_none(), "{:?}", out.error);
+    let stops = &map_core::Robot::trajectory(&robot).stops;
+    assert_eq!(stops.len(), 2);
+    // A room that is not on the map is not a room: left to the LLM.
+    let garage = vec![
+        Tuple::new("plant", None, None),
+        Tuple::new("garage", None, None),
+    ];
+    assert_eq!(
+        simple_goto_script("go to the plant in the garage", &garage, Some(&map)),
+        None
+    );
+}
+
+#[test]
 fn deterministic_goto_plans_read_second_nearest_as_the_default_order() {
     let map = flat_a();
     let t = vec![Tuple::new("chair", Some(2), Some("red"))];

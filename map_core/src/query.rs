@@ -132,6 +132,12 @@ pub enum QueryError {
     UnknownRegion { name: String, known: Vec<String> },
     #[error("the map has no instance with id {id}")]
     UnknownInstance { id: u32 },
+    #[error("there is no {name} in the {region} ({elsewhere} elsewhere on the map)")]
+    NoneInRegion {
+        name: String,
+        region: String,
+        elsewhere: usize,
+    },
 }
 
 fn holds(known: &[(String, usize)]) -> String {
@@ -196,6 +202,35 @@ impl IvlMap {
         order: ObjectOrder,
         robot: Pose,
     ) -> Result<&Instance, QueryError> {
+        self.pick(matcher, name, None, k, colour, order, robot)
+    }
+
+    /// [`IvlMap::get_obj_attributes`] among the objects whose footprint centroid lies in
+    /// the region `region` ("the plant in the lounge"): k counts only those.
+    pub fn get_obj_in_region(
+        &self,
+        name: &str,
+        region: &str,
+        k: i64,
+        colour: Option<&str>,
+        order: ObjectOrder,
+        robot: Pose,
+    ) -> Result<&Instance, QueryError> {
+        let r = self.find_region(region)?;
+        self.pick(&LexicalMatcher, name, Some(r), k, colour, order, robot)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn pick(
+        &self,
+        matcher: &dyn NameMatcher,
+        name: &str,
+        region: Option<&Region>,
+        k: i64,
+        colour: Option<&str>,
+        order: ObjectOrder,
+        robot: Pose,
+    ) -> Result<&Instance, QueryError> {
         if k < -1 {
             return Err(QueryError::BadOrdinal { k });
         }
@@ -211,7 +246,18 @@ impl IvlMap {
                 name: name.trim().to_string(),
                 known: self.label_counts(),
             })?;
-        let same: Vec<&Instance> = self.instances.iter().filter(|i| i.label == label).collect();
+        let mut same: Vec<&Instance> = self.instances.iter().filter(|i| i.label == label).collect();
+        if let Some(r) = region {
+            let all = same.len();
+            same.retain(|i| r.polygon.contains(i.centroid));
+            if same.is_empty() {
+                return Err(QueryError::NoneInRegion {
+                    name: label.to_string(),
+                    region: r.name.clone(),
+                    elsewhere: all,
+                });
+            }
+        }
         let colour = colour.map(str::trim).filter(|c| !c.is_empty());
         let mut cands: Vec<&Instance> = match colour {
             None => same.clone(),

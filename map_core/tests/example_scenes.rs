@@ -291,3 +291,72 @@ fn has_row_of_three(map: &IvlMap) -> bool {
     }
     false
 }
+
+/// "The plant in the lounge": only objects whose centroid lies in the room count, k
+/// counts among them, and a room without one says how many there are elsewhere.
+#[test]
+fn objects_in_a_region_are_those_inside_it() {
+    use map_core::{ObjectOrder, QueryError};
+    let mut inside_any = 0;
+    let mut none_in = 0;
+    for path in scene_paths() {
+        let map = IvlMap::from_scene(&Scene::from_path(&path).unwrap());
+        let mut labels: Vec<String> = map.instances.iter().map(|i| i.label.clone()).collect();
+        labels.sort();
+        labels.dedup();
+        for r in &map.regions {
+            for label in &labels {
+                let inside: Vec<u32> = map
+                    .instances
+                    .iter()
+                    .filter(|i| &i.label == label && r.polygon.contains(i.centroid))
+                    .map(|i| i.id)
+                    .collect();
+                let got = map.get_obj_in_region(
+                    label,
+                    &r.name,
+                    0,
+                    None,
+                    ObjectOrder::NearToFar,
+                    map.start_pose,
+                );
+                match got {
+                    Ok(i) => {
+                        assert!(inside.contains(&i.id), "{label} in {}", r.name);
+                        inside_any += 1;
+                        // The last in the region is in it too, and past the count errs.
+                        let last = map
+                            .get_obj_in_region(
+                                label,
+                                &r.name,
+                                -1,
+                                None,
+                                ObjectOrder::WestToEast,
+                                map.start_pose,
+                            )
+                            .unwrap();
+                        assert!(inside.contains(&last.id));
+                        let past = map.get_obj_in_region(
+                            label,
+                            &r.name,
+                            inside.len() as i64 + 1,
+                            None,
+                            ObjectOrder::NearToFar,
+                            map.start_pose,
+                        );
+                        assert!(
+                            matches!(past, Err(QueryError::OrdinalPastCount { count, .. }) if count == inside.len())
+                        );
+                    }
+                    Err(QueryError::NoneInRegion { elsewhere, .. }) => {
+                        assert!(inside.is_empty());
+                        assert!(elsewhere >= 1);
+                        none_in += 1;
+                    }
+                    Err(e) => panic!("{label} in {}: {e}", r.name),
+                }
+            }
+        }
+    }
+    assert!(inside_any >= 10 && none_in >= 10, "{inside_any} {none_in}");
+}

@@ -249,6 +249,27 @@ impl<'a> Host<'a> {
                     .map_err(map_err)?;
                 value(Dynamic::from(record(inst)))
             }
+            "get_obj_in_region" => {
+                let obj_name = self.name_arg(spec, 0, &args[0])?;
+                let region = self.name_arg(spec, 1, &args[1])?;
+                let k = match args.get(2) {
+                    Some(a) => self.ordinal_arg(spec, 2, a)?,
+                    None => 0,
+                };
+                let colour = match args.get(3) {
+                    Some(a) => self.colour_arg(spec, 3, a)?,
+                    None => None,
+                };
+                let order = match args.get(4) {
+                    Some(a) => self.order_arg(spec, 4, a)?,
+                    None => ObjectOrder::NearToFar,
+                };
+                let inst = self
+                    .map
+                    .get_obj_in_region(&obj_name, &region, k, colour.as_deref(), order, pose)
+                    .map_err(map_err)?;
+                value(Dynamic::from(record(inst)))
+            }
             "move_to" => {
                 let goal = self.position_arg(spec, 0, &args[0])?;
                 let rep = self

@@ -144,6 +144,26 @@ const fn opt(name: &'static str, ty: ParamType, doc: &'static str) -> ParamSpec 
     }
 }
 
+const REGION_ATTR_PARAMS: &[ParamSpec] = &[
+    req("object_name", ParamType::Name, "category name, e.g. \"plant\""),
+    req("region", ParamType::Name, "a region (room) name, e.g. \"lounge\""),
+    opt(
+        "instance_idx",
+        ParamType::Ordinal,
+        "k-th in the order among the objects in the region (1 = first), -1 = last, 0 = the nearest",
+    ),
+    opt(
+        "object_color",
+        ParamType::Colour,
+        "colour word such as \"yellow\", or \"\" for any colour",
+    ),
+    opt(
+        "order",
+        ParamType::Order,
+        "near_to_far (default), far_to_near, left_to_right, right_to_left, north_to_south, south_to_north, west_to_east, east_to_west",
+    ),
+];
+
 const OBJ: &[ParamSpec] = &[req(
     "object",
     ParamType::Object,
@@ -243,6 +263,14 @@ static REGISTRY: &[FunctionSpec] = &[
         "object record (fields: name, colour, label_id, id, position)",
         "pick one object by name, ordinal and colour; k counts in the order (default: nearest first)",
         "let table = agent.get_obj_attributes(\"table\", 3, \"yellow\");",
+        false,
+    ),
+    f(
+        "get_obj_in_region",
+        REGION_ATTR_PARAMS,
+        "object record (fields: name, colour, label_id, id, position)",
+        "pick one object in a room (\"the plant in the lounge\"), like get_obj_attributes counting only the objects in that region",
+        "let plant = agent.get_obj_in_region(\"plant\", \"lounge\");",
         false,
     ),
     f(
@@ -586,7 +614,7 @@ mod tests {
         ] {
             assert!(lookup(name).is_some(), "{name} missing");
         }
-        assert_eq!(registry().len(), 22);
+        assert_eq!(registry().len(), 23);
     }
 
     #[test]

@@ -216,6 +216,16 @@ pub fn align_script(src: &str, tuples: &[Tuple], map: Option<&IvlMap>) -> (Strin
             }
             continue;
         }
+        if call.function == "get_obj_in_region" {
+            // Its names are a category and a room, not objects: the checks compare its
+            // ordinal and colour with the tuple; the object and the room count as used.
+            for a in &call.args {
+                if let Arg::Str(name) = a {
+                    take(name);
+                }
+            }
+            continue;
+        }
         // Bare names where an object goes.
         let Some((_, open, end)) = call_span(src, call, &[spec.name]) else {
             continue;
@@ -340,6 +350,7 @@ fn target_binding(line: &str) -> Option<&str> {
     let rhs = rhs.trim();
     let rhs = rhs.strip_prefix("agent.").unwrap_or(rhs);
     let picks = [
+        "get_obj_in_region",
         "get_nearest_obj_pos",
         "get_specifed_obj_pos",
         "get_specified_obj_pos",

@@ -208,22 +208,37 @@ pub fn check_script(
             continue;
         };
         let at = Some(call.pos);
-        if call.function == "get_obj_attributes" {
-            let Some(Arg::Str(name)) = call.args.first() else {
+        if call.function == "get_obj_attributes" || call.function == "get_obj_in_region" {
+            // get_obj_in_region(name, region, k, colour, order): the same checks, and the
+            // map's answer within the region.
+            let (args, room): (Vec<Arg>, Option<String>) = if call.function == "get_obj_in_region" {
+                let room = match call.args.get(1) {
+                    Some(Arg::Str(r)) => Some(r.clone()),
+                    _ => None,
+                };
+                let mut a = call.args.clone();
+                if a.len() > 1 {
+                    a.remove(1);
+                }
+                (a, room)
+            } else {
+                (call.args.clone(), None)
+            };
+            let Some(Arg::Str(name)) = args.first() else {
                 continue;
             };
-            let k = match call.args.get(1) {
+            let k = match args.get(1) {
                 None | Some(Arg::Unit) => Some(0),
                 Some(Arg::Int(k)) => Some(*k),
                 _ => None,
             };
-            let colour: Option<Option<String>> = match call.args.get(2) {
+            let colour: Option<Option<String>> = match args.get(2) {
                 None | Some(Arg::Unit) => Some(None),
                 Some(Arg::Str(c)) if c.trim().is_empty() => Some(None),
                 Some(Arg::Str(c)) => Some(Some(c.clone())),
                 _ => None,
             };
-            let order = match call.args.get(3) {
+            let order = match args.get(3) {
                 None | Some(Arg::Unit) => Some(ObjectOrder::NearToFar),
                 Some(Arg::Str(o)) => match ObjectOrder::parse(o) {
                     Ok(o) => Some(o),
@@ -346,7 +361,11 @@ pub fn check_script(
                         ),
                     });
                 } else if colour_valid {
-                    if let Err(e) = m.get_obj_attributes(name, k, c.as_deref(), o, m.start_pose) {
+                    let answer = match &room {
+                        Some(r) => m.get_obj_in_region(name, r, k, c.as_deref(), o, m.start_pose),
+                        None => m.get_obj_attributes(name, k, c.as_deref(), o, m.start_pose),
+                    };
+                    if let Err(e) = answer {
                         out.push(map_finding(at, name, &e));
                     }
                 }

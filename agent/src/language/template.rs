@@ -8,6 +8,7 @@
 //! | "go to the north side of the table", "go south of the bed" | `move_north` ... `move_west` |
 //! | "go in between the black table and the red sofa" | `move_in_between` |
 //! | "face the tv", "turn to face the tv" | `face` |
+//! | "the plant in the lounge" (any of the above) | `get_obj_in_region` picks it |
 //!
 //! Every noun phrase must agree word for word with the tuple of its position (ordinal,
 //! colour, counting order), so a tuple step 1 got wrong, or a clause this table does not
@@ -320,6 +321,11 @@ pub fn simple_goto_script(
         if np == "it" {
             return last.clone().filter(|v| !v.starts_with('"'));
         }
+        // "the plant in the lounge": the object's tuple, then the room's.
+        let (np, room) = match np.rsplit_once(" in the ") {
+            Some((o, r)) if map.is_some() => (o, Some(r)),
+            _ => (np, None),
+        };
         let t = tuples.get(next)?;
         let mine = read_noun_phrase(np)?;
         if mine.object != t.object
@@ -329,7 +335,23 @@ pub fn simple_goto_script(
         {
             return None;
         }
-        next += 1;
+        let room = match room {
+            Some(r) => {
+                let rt = tuples.get(next + 1)?;
+                let said = read_noun_phrase(r)?;
+                let is_room = map.is_some_and(|m| is_region_only(m, &rt.object));
+                if !is_room
+                    || said.object != rt.object
+                    || rt.ordinal.is_some()
+                    || rt.colour.is_some()
+                {
+                    return None;
+                }
+                Some(rt.object.replace(['"', '\\'], ""))
+            }
+            None => None,
+        };
+        next += 1 + usize::from(room.is_some());
         let name = t.object.replace(['"', '\\'], "");
         if map.is_some_and(|m| is_region_only(m, &name)) {
             if !region_ok || t.ordinal.is_some() || t.colour.is_some() {
@@ -344,8 +366,12 @@ pub fn simple_goto_script(
             ObjectOrder::NearToFar => String::new(),
             o => format!(", \"{}\"", o.name()),
         };
+        let (f, room_arg) = match &room {
+            Some(r) => ("get_obj_in_region", format!(", \"{r}\"")),
+            None => ("get_obj_attributes", String::new()),
+        };
         script.push_str(&format!(
-            "let {v} = agent.get_obj_attributes(\"{name}\", {}, \"{}\"{order});\n",
+            "let {v} = agent.{f}(\"{name}\"{room_arg}, {}, \"{}\"{order});\n",
             t.ordinal.unwrap_or(0),
             t.colour.as_deref().unwrap_or("")
         ));
