@@ -231,18 +231,7 @@ impl<'a> Host<'a> {
             }
             "get_obj_attributes" => {
                 let obj_name = self.name_arg(spec, 0, &args[0])?;
-                let k = match args.get(1) {
-                    Some(a) => self.ordinal_arg(spec, 1, a)?,
-                    None => 0,
-                };
-                let colour = match args.get(2) {
-                    Some(a) => self.colour_arg(spec, 2, a)?,
-                    None => None,
-                };
-                let order = match args.get(3) {
-                    Some(a) => self.order_arg(spec, 3, a)?,
-                    None => ObjectOrder::NearToFar,
-                };
+                let (k, colour, order) = self.pick_args(spec, args, 1)?;
                 let inst = self
                     .map
                     .get_obj_attributes(&obj_name, k, colour.as_deref(), order, pose)
@@ -252,18 +241,7 @@ impl<'a> Host<'a> {
             "get_obj_in_region" => {
                 let obj_name = self.name_arg(spec, 0, &args[0])?;
                 let region = self.name_arg(spec, 1, &args[1])?;
-                let k = match args.get(2) {
-                    Some(a) => self.ordinal_arg(spec, 2, a)?,
-                    None => 0,
-                };
-                let colour = match args.get(3) {
-                    Some(a) => self.colour_arg(spec, 3, a)?,
-                    None => None,
-                };
-                let order = match args.get(4) {
-                    Some(a) => self.order_arg(spec, 4, a)?,
-                    None => ObjectOrder::NearToFar,
-                };
+                let (k, colour, order) = self.pick_args(spec, args, 2)?;
                 let inst = self
                     .map
                     .get_obj_in_region(&obj_name, &region, k, colour.as_deref(), order, pose)
@@ -542,6 +520,28 @@ impl<'a> Host<'a> {
             ));
         }
         Ok(k)
+    }
+
+    /// The optional (ordinal, colour, order) arguments of a pick, starting at `from`.
+    fn pick_args(
+        &self,
+        spec: &FunctionSpec,
+        args: &[Dynamic],
+        from: usize,
+    ) -> Result<(i64, Option<String>, ObjectOrder), CallError> {
+        let k = match args.get(from) {
+            Some(a) => self.ordinal_arg(spec, from, a)?,
+            None => 0,
+        };
+        let colour = match args.get(from + 1) {
+            Some(a) => self.colour_arg(spec, from + 1, a)?,
+            None => None,
+        };
+        let order = match args.get(from + 2) {
+            Some(a) => self.order_arg(spec, from + 2, a)?,
+            None => ObjectOrder::NearToFar,
+        };
+        Ok((k, colour, order))
     }
 
     fn colour_arg(
