@@ -344,8 +344,8 @@ fn deterministic_plans_pick_an_object_in_a_room() {
     .unwrap();
     assert_eq!(
         s,
-        "let target_2 = agent.get_obj_in_region(\"plant\", \"office\", 0, \"\");\nagent.move_to_object(target_2);\n\
-         let target_4 = agent.get_obj_in_region(\"chair\", \"dining room\", 2, \"black\");\nagent.move_to_object(target_4);\n"
+        "let target_1 = agent.get_obj_in_region(\"plant\", \"office\", 0, \"\");\nagent.move_to_object(target_1);\n\
+         let target_3 = agent.get_obj_in_region(\"chair\", \"dining room\", 2, \"black\");\nagent.move_to_object(target_3);\n"
     );
     let f = check_script(&s, &t, Some(&map)).unwrap();
     assert!(f.is_empty(), "{f:?}");

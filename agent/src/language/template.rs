@@ -361,7 +361,8 @@ pub fn simple_goto_script(
             last = Some(v.clone());
             return Some(v);
         }
-        let v = format!("target_{next}");
+        // Named after the object's tuple (the room's comes after it).
+        let v = format!("target_{}", next - usize::from(room.is_some()));
         let order = match t.object_order() {
             ObjectOrder::NearToFar => String::new(),
             o => format!(", \"{}\"", o.name()),
