@@ -326,42 +326,40 @@ fn brace_delta(line: &str) -> i64 {
     d
 }
 
-/// The variable a top-level one-line pick binds: `let v = [agent.]get_obj_attributes(...);`.
-fn pick_binding(line: &str) -> Option<&str> {
+/// A one-line `let name = [agent.]rhs;`: the name and the right-hand side without
+/// `agent.`.
+fn let_binding(line: &str) -> Option<(&str, &str)> {
     let rest = line.trim().strip_prefix("let ")?;
     let (name, rhs) = rest.split_once('=')?;
     let name = name.trim();
     let rhs = rhs.trim();
     let rhs = rhs.strip_prefix("agent.").unwrap_or(rhs);
-    (rhs.starts_with("get_obj_attributes")
-        && rhs.ends_with(';')
+    (rhs.ends_with(';')
         && !name.is_empty()
         && name.chars().all(|c| c.is_alphanumeric() || c == '_'))
-    .then_some(name)
+    .then_some((name, rhs))
+}
+
+/// The variable a top-level one-line pick binds: `let v = [agent.]get_obj_attributes(...);`.
+fn pick_binding(line: &str) -> Option<&str> {
+    let_binding(line)
+        .filter(|(_, rhs)| rhs.starts_with("get_obj_attributes"))
+        .map(|(name, _)| name)
 }
 
 /// `let x = agent.get_nearest_obj_pos("plant");`: a target a plan picks to go to (a
 /// script that never uses it stops short). A bare region name (`let r = "kitchen";`) is
 /// not one: "the plant in the kitchen" names a room that nothing goes to.
 fn target_binding(line: &str) -> Option<&str> {
-    let rest = line.trim().strip_prefix("let ")?;
-    let (name, rhs) = rest.split_once('=')?;
-    let name = name.trim();
-    let rhs = rhs.trim();
-    let rhs = rhs.strip_prefix("agent.").unwrap_or(rhs);
-    let picks = [
+    const PICKS: &[&str] = &[
         "get_obj_in_region",
         "get_nearest_obj_pos",
         "get_specifed_obj_pos",
         "get_specified_obj_pos",
-    ]
-    .iter()
-    .any(|f| rhs.starts_with(f));
-    (picks
-        && rhs.ends_with(';')
-        && !name.is_empty()
-        && name.chars().all(|c| c.is_alphanumeric() || c == '_'))
-    .then_some(name)
+    ];
+    let_binding(line)
+        .filter(|(_, rhs)| PICKS.iter().any(|f| rhs.starts_with(f)))
+        .map(|(name, _)| name)
 }
 
 fn mentions(line: &str, var: &str) -> bool {

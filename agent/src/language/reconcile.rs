@@ -514,7 +514,6 @@ pub fn reconcile_tuples(
     // Match each tuple to the first free mention of its name.
     let mut taken = vec![false; ms.len()];
     let mut placed: Vec<(usize, Tuple)> = Vec::new();
-    let mut kept_unplaced = false;
     let mut unplaced: Vec<Tuple> = Vec::new();
     for t in tuples {
         let c = canon(&t.object);
@@ -553,10 +552,7 @@ pub fn reconcile_tuples(
                         after: String::new(),
                         why: why.to_string(),
                     }),
-                    None => {
-                        kept_unplaced = true;
-                        unplaced.push(t.clone());
-                    }
+                    None => unplaced.push(t.clone()),
                 }
             }
         }
@@ -631,7 +627,7 @@ pub fn reconcile_tuples(
         }
     }
     // In order of mention, unless a tuple could not be placed (then the model's order).
-    if !kept_unplaced {
+    if unplaced.is_empty() {
         let was: Vec<Tuple> = placed.iter().map(|(_, t)| t.clone()).collect();
         placed.sort_by_key(|(k, _)| *k);
         let now: Vec<Tuple> = placed.iter().map(|(_, t)| t.clone()).collect();
