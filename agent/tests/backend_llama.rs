@@ -17,17 +17,8 @@ use agent::{
     LlamaCppConfig, LlmBackend, LlmError,
 };
 
-const SMOL: &str = "SmolLM2-135M-Instruct.Q4_1.gguf";
-
-fn models_dir() -> PathBuf {
-    if let Some(d) = std::env::var_os("IVLMAP_MODELS") {
-        return PathBuf::from(d);
-    }
-    let home = std::env::var_os("HOME")
-        .map(PathBuf::from)
-        .unwrap_or_default();
-    home.join(".cache/ivlmap/models")
-}
+mod support;
+use support::{models_dir, SMOL};
 
 /// The model file, or None (with the reason printed) when it has not been fetched.
 fn model(name: &str) -> Option<PathBuf> {

@@ -5,8 +5,11 @@
 //! VLMaps legacy map whose cells hold MiniLM embeddings (labelled by P = Q x E^T with
 //! the real encoder); then malformed inputs, each one line naming the file.
 
+mod support;
+use support::{ivlmap, repo, text};
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use map_core::{
     base_from_pose2d, models_dir, write_npy, write_rgb_png, write_sam_masks, write_vlmaps_legacy,
@@ -15,26 +18,6 @@ use map_core::{
     SegmentationForm, SyntheticOptions, TextEncoder, TextEncoderOptions, TopDownMaps,
     MINILM_MODEL_FILE, MINILM_TOKENIZER_FILE,
 };
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn ivlmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ivlmap"))
-        .args(args)
-        .current_dir(repo())
-        .env_remove("RUST_LOG")
-        .output()
-        .expect("run ivlmap")
-}
-
-fn text(o: &Output) -> (String, String) {
-    (
-        String::from_utf8_lossy(&o.stdout).to_string(),
-        String::from_utf8_lossy(&o.stderr).to_string(),
-    )
-}
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()

@@ -4,27 +4,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test helpers
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn ivlmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ivlmap"))
-        .args(args)
-        .current_dir(repo())
-        .output()
-        .expect("run ivlmap")
-}
-
-fn text(o: &Output) -> (String, String) {
-    (
-        String::from_utf8_lossy(&o.stdout).to_string(),
-        String::from_utf8_lossy(&o.stderr).to_string(),
-    )
-}
+mod support;
+use support::{ivlmap, text};
 
 #[test]
 fn map_inspect_prints_instances_and_regions() {

@@ -3,30 +3,10 @@
 //! reference plans' perfect score, noise costs the ordinal/colour plans, the same
 //! seeds give the same report, and bad rates, kinds and suites are one-line errors.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod support;
+use support::{ivlmap, repo, text};
 
 use serde_json::Value;
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn ivlmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ivlmap"))
-        .args(args)
-        .current_dir(repo())
-        .env_remove("RUST_LOG")
-        .output()
-        .expect("run ivlmap")
-}
-
-fn text(o: &Output) -> (String, String) {
-    (
-        String::from_utf8_lossy(&o.stdout).to_string(),
-        String::from_utf8_lossy(&o.stderr).to_string(),
-    )
-}
 
 fn row<'a>(study: &'a Value, rate: f64, method: &str) -> &'a Value {
     study["rows"]

@@ -4,6 +4,8 @@
 //! `IVLMAP_RECORD=1 cargo test -p agent --release --test language_e2e -- --nocapture`
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod support;
+
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -32,12 +34,7 @@ fn cassette() -> PathBuf {
 }
 
 fn smol_path() -> Option<PathBuf> {
-    let dir = std::env::var_os("IVLMAP_MODELS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            PathBuf::from(std::env::var_os("HOME").unwrap_or_default()).join(".cache/ivlmap/models")
-        });
-    let p = dir.join("SmolLM2-135M-Instruct.Q4_1.gguf");
+    let p = support::models_dir().join(support::SMOL);
     if p.is_file() {
         Some(p)
     } else {

@@ -4,7 +4,7 @@
 //! nothing outside the function library, even when the model would ramble.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use std::path::PathBuf;
+mod support;
 
 use agent::{
     extract_code, extract_tuples_with, CompletionRequest, LlamaCppBackend, LlamaCppConfig,
@@ -13,12 +13,7 @@ use agent::{
 use planner_dsl::{Plan, PlanError, ViolationKind};
 
 fn smol() -> LlamaCppBackend {
-    let dir = std::env::var_os("IVLMAP_MODELS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            PathBuf::from(std::env::var_os("HOME").unwrap_or_default()).join(".cache/ivlmap/models")
-        });
-    let p = dir.join("SmolLM2-135M-Instruct.Q4_1.gguf");
+    let p = support::models_dir().join(support::SMOL);
     assert!(
         p.is_file(),
         "{} is absent: run scripts/setup.sh (it fetches the models)",

@@ -14,16 +14,10 @@ pub const DEFAULT_MODEL_FILE: &str = "qwen2.5-coder-1.5b-instruct-q4_k_m.gguf";
 /// `~/.cache/ivlmap/models/<file>`.
 #[must_use]
 pub fn default_model_path() -> PathBuf {
-    let dir = std::env::var_os("IVLMAP_MODELS")
-        .filter(|v| !v.is_empty())
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            let home = std::env::var_os("HOME")
-                .map(PathBuf::from)
-                .unwrap_or_default();
-            home.join(".cache/ivlmap/models")
-        });
-    dir.join(DEFAULT_MODEL_FILE)
+    // map_core's folder (the ONNX models live there too); with no HOME, relative.
+    map_core::models_dir()
+        .unwrap_or_else(|_| PathBuf::from(".cache/ivlmap/models"))
+        .join(DEFAULT_MODEL_FILE)
 }
 
 /// Which backend to open, as given on the command line.
