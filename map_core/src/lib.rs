@@ -68,14 +68,14 @@ pub use crate::planner::{
 };
 pub use crate::query::{ordinal_word, ObjectOrder, QueryError};
 pub use crate::reconstruct::{
-    base_from_pose2d, import_vlmaps_legacy, map_frame, parse_poses_txt, pose2d_from_base,
-    read_depth, read_poses_txt, read_rgb_png, reconstruct, reconstruct_with_progress, render_rgbd,
-    vlmaps_grid_frame, world_poses, write_depth_npy, write_depth_png, write_poses_txt,
-    write_rgb_png, write_vlmaps_legacy, Anchor, CameraInfo, FeatureGrid, FrameFiles, FramePose,
-    Intrinsics, MapSpec, PoseConvention, ReconstructError, ReconstructOptions, RgbdDataset,
-    RgbdFrame, RgbdRenderer, SyntheticOptions, TopDownBuilder, TopDownMaps, VlmapsCrop,
-    VlmapsImportOptions, VlmapsLegacyMap, VlmapsWindow, WorldPoses, DEFAULT_OBJECT_HEIGHT,
-    RGBD_FORMAT,
+    base_from_pose2d, fortran_to_c, import_vlmaps_legacy, map_frame, parse_poses_txt,
+    pose2d_from_base, read_depth, read_poses_txt, read_rgb_png, reconstruct,
+    reconstruct_with_progress, render_rgbd, vlmaps_grid_frame, world_poses, write_depth_npy,
+    write_depth_png, write_poses_txt, write_rgb_png, write_vlmaps_legacy, Anchor, CameraInfo,
+    FeatureGrid, FrameFiles, FramePose, Intrinsics, MapSpec, PoseConvention, ReconstructError,
+    ReconstructOptions, RgbdDataset, RgbdFrame, RgbdRenderer, SyntheticOptions, TopDownBuilder,
+    TopDownMaps, VlmapsCrop, VlmapsImportOptions, VlmapsLegacyMap, VlmapsWindow, WorldPoses,
+    DEFAULT_OBJECT_HEIGHT, RGBD_FORMAT,
 };
 pub use crate::render::{
     auto_scale, colour_rgb, render_png, render_rgb, render_trajectory_png, RenderError,

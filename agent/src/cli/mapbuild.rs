@@ -752,7 +752,7 @@ fn read_nd(path: &Path) -> Result<NdValues, CliError> {
         _ => return Err(bad()),
     };
     let values = if fortran && shape.len() > 1 {
-        c_order(&values, &shape)
+        map_core::fortran_to_c(&values, &shape)
     } else {
         values
     };
@@ -765,31 +765,6 @@ fn read_nd(path: &Path) -> Result<NdValues, CliError> {
         values,
         integer,
     })
-}
-
-/// Fortran-order values rearranged into C order.
-fn c_order(values: &[f64], shape: &[usize]) -> Vec<f64> {
-    let mut out = vec![0.0; values.len()];
-    let n = shape.len();
-    let mut idx = vec![0usize; n];
-    for &v in values {
-        // `idx` counts in Fortran order (first axis fastest)
-        let mut c = 0usize;
-        for (k, &i) in idx.iter().enumerate() {
-            c = c * shape[k] + i;
-        }
-        if let Some(slot) = out.get_mut(c) {
-            *slot = v;
-        }
-        for (k, i) in idx.iter_mut().enumerate() {
-            *i += 1;
-            if *i < shape[k] {
-                break;
-            }
-            *i = 0;
-        }
-    }
-    out
 }
 
 fn npy_2d_shape(path: &Path) -> Result<(usize, usize), CliError> {

@@ -123,6 +123,7 @@ pub use frames::{
     read_depth, read_rgb_png, write_depth_npy, write_depth_png, write_rgb_png, FrameFiles,
     RgbdDataset, RgbdFrame,
 };
+pub use ndnpy::fortran_to_c;
 pub use poses::{
     base_from_pose2d, parse_poses_txt, pose2d_from_base, read_poses_txt, world_poses,
     write_poses_txt, Anchor, FramePose, PoseConvention, WorldPoses,

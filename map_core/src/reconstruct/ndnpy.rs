@@ -197,8 +197,13 @@ pub(crate) fn read_nd(path: &Path) -> Result<NdArray, ReconstructError> {
     Ok(NdArray { shape, dtype, data })
 }
 
-/// Permute column-major data of `shape` into row-major order.
-fn fortran_to_c<T: Copy + Default>(data: &[T], shape: &[usize]) -> Vec<T> {
+/// Permute column-major (numpy `order='F'`) data of `shape` into row-major order.
+///
+/// ```
+/// // [[1, 2, 3], [4, 5, 6]] stored first axis fastest
+/// assert_eq!(map_core::fortran_to_c(&[1, 4, 2, 5, 3, 6], &[2, 3]), vec![1, 2, 3, 4, 5, 6]);
+/// ```
+pub fn fortran_to_c<T: Copy + Default>(data: &[T], shape: &[usize]) -> Vec<T> {
     let mut out = vec![T::default(); data.len()];
     let n = shape.len();
     let mut idx = vec![0usize; n];
