@@ -3,7 +3,7 @@
     python bench/eq2_numpy.py DIR [--reps N]
 
 Reads DIR/labels.npy, DIR/masks.json (SAM output, COCO RLE) and DIR/config.json as
-written by `cargo run --release -p map_core --example eq2_bench -- gen DIR`, labels
+written by `cargo run --release -p map_build --example eq2_bench -- gen DIR`, labels
 every mask, and writes DIR/numpy_result.json (per-mask outcome, label, score, top k,
 and the median times). The algorithm is the one map_core implements:
 

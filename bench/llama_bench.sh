@@ -138,7 +138,7 @@ log "llama-bench: $bench_bin"
 
 target_dir="${CARGO_TARGET_DIR:-$ROOT/target}"
 log "building agent example tok_per_s (release)"
-(cd "$ROOT" && cargo build --release --quiet -p agent --example tok_per_s >&2)
+(cd "$ROOT" && cargo build --release --quiet -p llm --example tok_per_s >&2)
 ours_bin="$target_dir/release/examples/tok_per_s"
 [ -x "$ours_bin" ] || die "no $ours_bin after the build"
 

@@ -1,7 +1,9 @@
 //! Agreement checks, deterministic plans and tuple resolution on a real example scene.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use agent::{check_script, library_calls, simple_goto_script, Arg, FindingKind, Tuple};
+use agent::checks::{check_script, library_calls, Arg, FindingKind};
+use agent::template::simple_goto_script;
+use agent::Tuple;
 use map_core::{IvlMap, Scene};
 
 fn flat_a() -> IvlMap {
@@ -350,7 +352,7 @@ fn deterministic_plans_pick_an_object_in_a_room() {
     let f = check_script(&s, &t, Some(&map)).unwrap();
     assert!(f.is_empty(), "{f:?}");
     // Alignment leaves its names alone.
-    let (aligned, fixes) = agent::align_script(&s, &t, Some(&map));
+    let (aligned, fixes) = agent::align::align_script(&s, &t, Some(&map));
     assert_eq!((aligned.as_str(), fixes.len()), (s.as_str(), 0));
     // The plan runs and stops at the office's plant (id 30), not the nearer ones.
     let plan = planner_dsl::Plan::compile(&s).unwrap();

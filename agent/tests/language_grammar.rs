@@ -4,16 +4,14 @@
 //! nothing outside the function library, even when the model would ramble.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-mod support;
-
-use agent::{
-    extract_code, extract_tuples_with, CompletionRequest, LlamaCppBackend, LlamaCppConfig,
-    LlmBackend, PlanOptions, Prompts, Tuple,
-};
+use agent::pipeline::extract_tuples_with;
+use agent::script::extract_code;
+use agent::{PlanOptions, Prompts, Tuple};
+use llm::{CompletionRequest, LlamaCppBackend, LlamaCppConfig, LlmBackend};
 use planner_dsl::{Plan, PlanError, ViolationKind};
 
 fn smol() -> LlamaCppBackend {
-    let p = support::models_dir().join(support::SMOL);
+    let p = ivlmap_tests::models_dir().join(ivlmap_tests::SMOL);
     assert!(
         p.is_file(),
         "{} is absent: run scripts/setup.sh (it fetches the models)",
@@ -40,7 +38,10 @@ fn tuple_grammar_makes_every_answer_readable() {
             .unwrap_or_else(|e| panic!("{instruction}: {e}"));
         for t in &tuples {
             if let Some(c) = &t.colour {
-                assert!(map_core::is_colour_word(c), "{instruction}: colour {c:?}");
+                assert!(
+                    map_core::matcher::is_colour_word(c),
+                    "{instruction}: colour {c:?}"
+                );
             }
             assert!(
                 t.ordinal.is_none_or(|k| k >= 1 || k == -1),

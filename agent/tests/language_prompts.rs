@@ -1,7 +1,8 @@
 //! Prompt files: the repository's folder, variant overlays, errors that name the file.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use agent::{PromptError, Prompts, Tuple, TEMPLATE_NAMES};
+use agent::prompts::TEMPLATE_NAMES;
+use agent::{PromptError, Prompts, Tuple};
 
 fn repo_prompts() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../prompts")

@@ -7,13 +7,17 @@
 // A benchmark with a missing fixture or a wrong answer must stop loudly.
 #![allow(clippy::expect_used, clippy::unwrap_used, clippy::panic)]
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use map_core::{line_of_sight, read_npy, Cell, Grid, GridPlanner};
+use map_core::npy::read_npy;
+use map_core::planner::line_of_sight;
+use map_core::{Cell, Grid, GridPlanner};
+
+#[path = "../tests/common/reference.rs"]
+#[allow(dead_code)] // the bench uses the optimum only
+mod reference;
 
 fn bench_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/bench")
@@ -56,59 +60,6 @@ fn load() -> Fixture {
     (grid.map(|&v| v != 0), pairs, vl, cell_size)
 }
 
-/// Textbook Dijkstra, 8-connected, no corner cutting: the reference optimum.
-fn dijkstra(g: &Grid<bool>, s: Cell, t: Cell) -> f64 {
-    let (rows, cols) = (g.rows(), g.cols());
-    let free = |r: isize, c: isize| {
-        r >= 0
-            && c >= 0
-            && (r as usize) < rows
-            && (c as usize) < cols
-            && !g.as_slice()[r as usize * cols + c as usize]
-    };
-    let mut dist = vec![f64::INFINITY; rows * cols];
-    let mut heap = BinaryHeap::new();
-    dist[s.row * cols + s.col] = 0.0;
-    heap.push(Reverse((0u64, s.row * cols + s.col)));
-    while let Some(Reverse((d, i))) = heap.pop() {
-        let d = f64::from_bits(d);
-        if d > dist[i] {
-            continue;
-        }
-        if i == t.row * cols + t.col {
-            return d;
-        }
-        let (r, c) = ((i / cols) as isize, (i % cols) as isize);
-        for (dr, dc) in [
-            (-1, 0),
-            (1, 0),
-            (0, -1),
-            (0, 1),
-            (-1, -1),
-            (-1, 1),
-            (1, -1),
-            (1, 1),
-        ] {
-            if !free(r + dr, c + dc)
-                || (dr != 0 && dc != 0 && !(free(r + dr, c) && free(r, c + dc)))
-            {
-                continue;
-            }
-            let j = (r + dr) as usize * cols + (c + dc) as usize;
-            let nd = d + if dr != 0 && dc != 0 {
-                std::f64::consts::SQRT_2
-            } else {
-                1.0
-            };
-            if nd < dist[j] {
-                dist[j] = nd;
-                heap.push(Reverse((nd.to_bits(), j)));
-            }
-        }
-    }
-    f64::INFINITY
-}
-
 fn check_answers(
     grid: &Grid<bool>,
     planner: &GridPlanner,
@@ -139,7 +90,7 @@ fn check_answers(
         );
         assert!(p.smoothed_len <= p.raw_len + 1e-9);
         if k % 10 == 0 {
-            let opt = dijkstra(grid, s, t);
+            let opt = reference::dijkstra(grid, s, t).unwrap_or(f64::INFINITY);
             assert!(
                 (p.raw_len - opt).abs() < 1e-6 * opt.max(1.0),
                 "pair {k}: JPS {} != Dijkstra {opt}",

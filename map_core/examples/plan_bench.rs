@@ -8,15 +8,28 @@
 
 use std::time::Instant;
 
-use map_core::{read_npy, Cell, Grid, GridPlanner};
+use map_core::npy::read_npy;
+use map_core::{Cell, Grid, GridPlanner};
+
+/// Time the grid planner on GRID.npy and QUERIES.json.
+#[derive(Debug, clap::Parser)]
+struct Args {
+    /// uint8 obstacle grid, 1 = occupied, already inflated.
+    grid: std::path::PathBuf,
+    /// `{"cell_size_m": 0.05, "pairs": [{"start": [row, col], "goal": [row, col]}, ...]}`.
+    queries: std::path::PathBuf,
+    /// Warm-query repetitions.
+    #[arg(default_value_t = 5)]
+    repeats: usize,
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().collect();
-    let (Some(grid_path), Some(q_path)) = (args.get(1), args.get(2)) else {
-        return Err("usage: plan_bench GRID.npy QUERIES.json".into());
-    };
-    let repeats: usize = args.get(3).map(|s| s.parse()).transpose()?.unwrap_or(5);
-    let q: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(q_path)?)?;
+    let Args {
+        grid: grid_path,
+        queries: q_path,
+        repeats,
+    } = clap::Parser::parse();
+    let q: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&q_path)?)?;
     let cell_size = q["cell_size_m"].as_f64().unwrap_or(0.05);
     let cell = |v: &serde_json::Value| -> Option<Cell> {
         Some(Cell::new(
@@ -38,7 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (&(s0, g0), _) = pairs.split_first().ok_or("queries: no pairs")?;
 
     let t0 = Instant::now();
-    let raw: Grid<u8> = read_npy(grid_path)?;
+    let raw: Grid<u8> = read_npy(&grid_path)?;
     let grid = raw.map(|&v| v != 0);
     let t_load = Instant::now();
     let planner = GridPlanner::new(grid);

@@ -5,41 +5,51 @@ use serde::{Deserialize, Serialize};
 /// A point in the world frame, metres: `x` east, `y` north.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Point {
+    /// Metres east.
     pub x: f64,
+    /// Metres north.
     pub y: f64,
 }
 
 impl Point {
+    /// A point at (`x`, `y`) metres.
     pub const fn new(x: f64, y: f64) -> Self {
         Self { x, y }
     }
 
+    /// Euclidean distance to `other`, metres.
     pub fn dist(self, other: Point) -> f64 {
         (self.x - other.x).hypot(self.y - other.y)
     }
 
+    /// Whether both coordinates are finite.
     pub fn is_finite(self) -> bool {
         self.x.is_finite() && self.y.is_finite()
     }
 
+    /// Component-wise sum `self + o`.
     #[allow(clippy::should_implement_trait)] // also implemented; the method reads better in chains
     pub fn add(self, o: Point) -> Point {
         Point::new(self.x + o.x, self.y + o.y)
     }
 
+    /// Component-wise difference `self - o`.
     #[allow(clippy::should_implement_trait)]
     pub fn sub(self, o: Point) -> Point {
         Point::new(self.x - o.x, self.y - o.y)
     }
 
+    /// Both coordinates multiplied by `s`.
     pub fn scale(self, s: f64) -> Point {
         Point::new(self.x * s, self.y * s)
     }
 
+    /// Length of the vector from the origin.
     pub fn norm(self) -> f64 {
         self.x.hypot(self.y)
     }
 
+    /// Dot product with `o`.
     pub fn dot(self, o: Point) -> f64 {
         self.x * o.x + self.y * o.y
     }
@@ -52,7 +62,7 @@ impl Point {
     /// Compass heading (degrees, 0 north, 90 east) of the direction from `self` to `to`.
     pub fn heading_to(self, to: Point) -> f64 {
         let d = to.sub(self);
-        normalize_heading(d.x.atan2(d.y).to_degrees())
+        normalise_heading(d.x.atan2(d.y).to_degrees())
     }
 
     /// The unit vector of a compass heading (0 = north = +y, 90 = east = +x).
@@ -96,7 +106,7 @@ impl From<Point> for [f64; 2] {
 }
 
 /// Normalise a compass heading to (-180, 180].
-pub fn normalize_heading(h: f64) -> f64 {
+pub fn normalise_heading(h: f64) -> f64 {
     let mut a = h % 360.0;
     if a <= -180.0 {
         a += 360.0;
@@ -109,15 +119,18 @@ pub fn normalize_heading(h: f64) -> f64 {
 /// A robot pose: position and compass heading in degrees (0 north, 90 east, clockwise).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Pose {
+    /// Position in the world frame, metres.
     pub position: Point,
+    /// Compass heading, degrees (0 north, 90 east, clockwise).
     pub heading: f64,
 }
 
 impl Pose {
+    /// A pose at (`x`, `y`) metres facing compass `heading` degrees (normalised).
     pub fn new(x: f64, y: f64, heading: f64) -> Self {
         Self {
             position: Point::new(x, y),
-            heading: normalize_heading(heading),
+            heading: normalise_heading(heading),
         }
     }
 
@@ -140,11 +153,14 @@ impl Pose {
 /// Axis-aligned bounding box in world metres.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Aabb {
+    /// South-west corner (smallest x and y).
     pub min: Point,
+    /// North-east corner (largest x and y).
     pub max: Point,
 }
 
 impl Aabb {
+    /// The smallest box holding all `pts`; `None` when `pts` is empty.
     pub fn from_points(pts: &[Point]) -> Option<Aabb> {
         let first = *pts.first()?;
         let mut b = Aabb {
@@ -160,6 +176,7 @@ impl Aabb {
         Some(b)
     }
 
+    /// Centre of the box.
     pub fn center(&self) -> Point {
         Point::new(
             (self.min.x + self.max.x) / 2.0,
@@ -167,14 +184,17 @@ impl Aabb {
         )
     }
 
+    /// East-west extent, metres.
     pub fn width(&self) -> f64 {
         self.max.x - self.min.x
     }
 
+    /// North-south extent, metres.
     pub fn height(&self) -> f64 {
         self.max.y - self.min.y
     }
 
+    /// Length of the diagonal, metres.
     pub fn diagonal(&self) -> f64 {
         self.width().hypot(self.height())
     }
@@ -185,6 +205,7 @@ impl Aabb {
 pub struct Polygon(pub Vec<Point>);
 
 impl Polygon {
+    /// The vertices, in order.
     pub fn vertices(&self) -> &[Point] {
         &self.0
     }
@@ -246,6 +267,7 @@ impl Polygon {
         c.scale(1.0 / (3.0 * a))
     }
 
+    /// Bounding box of the vertices; `None` for an empty polygon.
     pub fn bbox(&self) -> Option<Aabb> {
         Aabb::from_points(&self.0)
     }
@@ -345,9 +367,9 @@ mod tests {
 
     #[test]
     fn heading_normalises_into_half_open_range() {
-        assert_eq!(normalize_heading(180.0), 180.0);
-        assert_eq!(normalize_heading(-180.0), 180.0);
-        assert_eq!(normalize_heading(270.0), -90.0);
-        assert_eq!(normalize_heading(-450.0), -90.0);
+        assert_eq!(normalise_heading(180.0), 180.0);
+        assert_eq!(normalise_heading(-180.0), 180.0);
+        assert_eq!(normalise_heading(270.0), -90.0);
+        assert_eq!(normalise_heading(-450.0), -90.0);
     }
 }

@@ -3,7 +3,7 @@
 //! geometry and the robot's pose; the planner snaps a goal that lies in an
 //! inflated obstacle to the nearest reachable free cell.
 
-use crate::geometry::{closest_on_segment, normalize_heading, Point, Polygon, Pose};
+use crate::geometry::{closest_on_segment, normalise_heading, Point, Polygon, Pose};
 use crate::map::{Instance, Region};
 
 /// Distance beyond a footprint's bounding-box edge for move_north/south/east/west.
@@ -12,9 +12,13 @@ pub const SIDE_CLEARANCE_M: f64 = 0.5;
 /// A compass side of an object.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Side {
+    /// The north side (+y).
     North,
+    /// The south side (-y).
     South,
+    /// The east side (+x).
     East,
+    /// The west side (-x).
     West,
 }
 
@@ -96,7 +100,7 @@ pub fn face_heading(robot: Pose, obj: &Instance) -> f64 {
 /// or right.
 pub fn heading_with_object_on(robot: Pose, obj: &Instance, left: bool) -> f64 {
     let bearing = face_heading(robot, obj);
-    normalize_heading(if left { bearing + 90.0 } else { bearing - 90.0 })
+    normalise_heading(if left { bearing + 90.0 } else { bearing - 90.0 })
 }
 
 /// Where `move_to` a region aims: its centroid if inside, else the middle of its
@@ -125,7 +129,7 @@ mod tests {
             label: "table".into(),
             label_id: 1,
             num_of_same_class: 1,
-            color: None,
+            colour: None,
             area: 0,
             area_m2: contour.area(),
             bbox: [0; 4],

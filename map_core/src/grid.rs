@@ -8,11 +8,14 @@ use crate::geometry::Point;
 /// A grid cell index: `row` counts south from the north edge, `col` east from the west edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct Cell {
+    /// Row index, counting south from the north edge (row 0).
     pub row: usize,
+    /// Column index, counting east from the west edge (column 0).
     pub col: usize,
 }
 
 impl Cell {
+    /// The cell at (`row`, `col`).
     pub const fn new(row: usize, col: usize) -> Self {
         Self { row, col }
     }
@@ -27,6 +30,7 @@ pub struct Grid<T> {
 }
 
 impl<T: Clone> Grid<T> {
+    /// A `rows` x `cols` grid with every cell set to `fill`.
     pub fn new(rows: usize, cols: usize, fill: T) -> Self {
         Self {
             rows,
@@ -42,34 +46,42 @@ impl<T> Grid<T> {
         (rows.checked_mul(cols) == Some(data.len())).then_some(Self { rows, cols, data })
     }
 
+    /// Number of rows (north to south).
     pub fn rows(&self) -> usize {
         self.rows
     }
 
+    /// Number of columns (west to east).
     pub fn cols(&self) -> usize {
         self.cols
     }
 
+    /// Number of cells (`rows * cols`).
     pub fn len(&self) -> usize {
         self.data.len()
     }
 
+    /// Whether the grid has no cells.
     pub fn is_empty(&self) -> bool {
         self.data.is_empty()
     }
 
+    /// Whether signed (`row`, `col`) lies inside the grid.
     pub fn in_bounds(&self, row: isize, col: isize) -> bool {
         row >= 0 && col >= 0 && (row as usize) < self.rows && (col as usize) < self.cols
     }
 
+    /// Row-major index of a cell (not bounds-checked).
     pub fn index(&self, c: Cell) -> usize {
         c.row * self.cols + c.col
     }
 
+    /// The cell at a row-major index (inverse of [`Grid::index`]).
     pub fn cell_of(&self, index: usize) -> Cell {
         Cell::new(index / self.cols, index % self.cols)
     }
 
+    /// The value at a cell, or `None` out of bounds.
     pub fn get(&self, c: Cell) -> Option<&T> {
         if c.row < self.rows && c.col < self.cols {
             self.data.get(c.row * self.cols + c.col)
@@ -78,6 +90,7 @@ impl<T> Grid<T> {
         }
     }
 
+    /// Mutable access to a cell's value, or `None` out of bounds.
     pub fn get_mut(&mut self, c: Cell) -> Option<&mut T> {
         if c.row < self.rows && c.col < self.cols {
             self.data.get_mut(c.row * self.cols + c.col)
@@ -93,14 +106,17 @@ impl<T> Grid<T> {
         }
     }
 
+    /// The row-major data.
     pub fn as_slice(&self) -> &[T] {
         &self.data
     }
 
+    /// The row-major data, mutably.
     pub fn as_mut_slice(&mut self) -> &mut [T] {
         &mut self.data
     }
 
+    /// Consume the grid, returning its row-major data.
     pub fn into_vec(self) -> Vec<T> {
         self.data
     }
@@ -114,6 +130,7 @@ impl<T> Grid<T> {
             .map(move |(i, v)| (Cell::new(i / cols, i % cols), v))
     }
 
+    /// A grid of the same shape with `f` applied to every cell.
     pub fn map<U>(&self, f: impl Fn(&T) -> U) -> Grid<U> {
         Grid {
             rows: self.rows,
@@ -130,7 +147,9 @@ pub struct GridFrame {
     pub origin: Point,
     /// Metres per cell.
     pub cell_size: f64,
+    /// Number of rows (north to south).
     pub rows: usize,
+    /// Number of columns (west to east).
     pub cols: usize,
 }
 

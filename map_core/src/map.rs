@@ -19,8 +19,9 @@ pub struct Instance {
     pub label_id: u32,
     /// How many instances share this label.
     pub num_of_same_class: u32,
-    /// Colour word, if known.
-    pub color: Option<String>,
+    /// Colour word, if known (`color` in JSON, as the paper's Listing 1).
+    #[serde(rename = "color")]
+    pub colour: Option<String>,
     /// Footprint area in cells (SAM's `area`).
     pub area: u64,
     /// Footprint area in square metres.
@@ -60,7 +61,9 @@ impl Instance {
 /// A named region (room); not an obstacle.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Region {
+    /// Region name from the scene, e.g. "kitchen".
     pub name: String,
+    /// Outline in world metres.
     pub polygon: Polygon,
 }
 
@@ -69,6 +72,7 @@ pub struct Region {
 pub struct IvlMap {
     /// Name of the scene or map.
     pub name: String,
+    /// Where the grid lies in the world; shared by every layer.
     pub frame: GridFrame,
     /// Occupied cells (walls and objects), not inflated.
     pub obstacles: Grid<bool>,
@@ -82,7 +86,9 @@ pub struct IvlMap {
     pub categories: Vec<String>,
     /// Colour names, indexed by colour id - 1.
     pub colours: Vec<String>,
+    /// The instance table, one entry per object.
     pub instances: Vec<Instance>,
+    /// Named regions (rooms).
     pub regions: Vec<Region>,
     /// Robot radius in metres (obstacles are inflated by it for planning).
     pub robot_radius: f64,
@@ -152,7 +158,7 @@ impl IvlMap {
                 label,
                 label_id: 0,
                 num_of_same_class: 0,
-                color: o.colour.as_ref().map(|c| c.0.clone()),
+                colour: o.colour.as_ref().map(|c| c.0.clone()),
                 area: cells.len() as u64,
                 area_m2: poly.area(),
                 bbox,
@@ -228,7 +234,7 @@ impl IvlMap {
 /// rounding to this many metres (1 micrometre), so two instances whose centroids
 /// differ only by floating-point noise (3.599999999999996 and 3.5999999999999934,
 /// from rotated footprints) count as level and the next rule decides.
-pub(crate) const LABEL_ORDER_RESOLUTION_M: f64 = 1e-6;
+pub const LABEL_ORDER_RESOLUTION_M: f64 = 1e-6;
 
 /// A coordinate on the [`LABEL_ORDER_RESOLUTION_M`] lattice (rounding, not a
 /// tolerance, so the order stays transitive).
@@ -240,7 +246,7 @@ fn order_key(v: f64) -> i64 {
 /// Recompute `label_id` (1-based, west to east then north to south by centroid,
 /// each compared at [`LABEL_ORDER_RESOLUTION_M`]; then by id) and
 /// `num_of_same_class` for every instance.
-pub(crate) fn assign_label_ids(instances: &mut [Instance]) {
+pub fn assign_label_ids(instances: &mut [Instance]) {
     let mut labels: Vec<String> = instances.iter().map(|i| i.label.clone()).collect();
     labels.sort();
     labels.dedup();

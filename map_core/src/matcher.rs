@@ -108,12 +108,12 @@ pub const COLOUR_WORDS: &[&str] = &[
 
 /// Whether `word` is a colour word (after normalisation).
 pub fn is_colour_word(word: &str) -> bool {
-    let w = normalize(word);
+    let w = normalise(word);
     COLOUR_WORDS.contains(&w.as_str())
 }
 
 /// Lower-case, trim, drop leading articles, collapse whitespace and underscores.
-pub fn normalize(s: &str) -> String {
+pub fn normalise(s: &str) -> String {
     let lower = s.trim().to_lowercase().replace(['_', '-'], " ");
     let mut words: Vec<&str> = lower.split_whitespace().collect();
     while words.len() > 1 && matches!(words[0], "the" | "a" | "an" | "that" | "this") {
@@ -188,7 +188,7 @@ pub fn plural(phrase: &str) -> String {
 
 /// The canonical form of a name: normalised, singular, synonym group head.
 pub fn canonical(s: &str) -> String {
-    let n = normalize(s);
+    let n = normalise(s);
     for cand in [n.clone(), singular(&n)] {
         for group in SYNONYMS {
             if group.contains(&cand.as_str()) {

@@ -48,8 +48,11 @@ const MAX_CELLS: usize = 400_000_000;
 /// field path (`instances[3].bbox`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct JsonLocation {
+    /// 1-based line, where known.
     pub line: Option<usize>,
+    /// 1-based column, where known.
     pub column: Option<usize>,
+    /// Path of the offending field, e.g. `instances[3].bbox`; empty when unknown.
     pub field: String,
 }
 
@@ -62,38 +65,61 @@ impl fmt::Display for JsonLocation {
 /// Why a map folder could not be saved or loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum PersistError {
+    /// A file or folder could not be created, read or written.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file or folder concerned.
         path: PathBuf,
+        /// The underlying I/O error.
         #[source]
         source: std::io::Error,
     },
+    /// A JSON file does not parse into its records, or a record could not be serialised.
     #[error("{}{at}: {message}", path.display())]
     Json {
+        /// The JSON file concerned.
         path: PathBuf,
+        /// Where in the file the problem is.
         at: JsonLocation,
+        /// What serde_json reported.
         message: String,
     },
+    /// `map.json` carries a `format` tag other than [`MAP_FORMAT`].
     #[error("{}: field `format`: unknown map format {found:?}; this reader accepts {MAP_FORMAT:?}", path.display())]
-    UnknownFormat { path: PathBuf, found: String },
+    UnknownFormat {
+        /// The `map.json` concerned.
+        path: PathBuf,
+        /// The format tag found in the file.
+        found: String,
+    },
+    /// A layer `.npy` file could not be read or written.
     #[error(transparent)]
     Npy(#[from] NpyError),
+    /// A layer's shape differs from the frame's rows and columns in `map.json`.
     #[error(
         "{}: layer shape {rows}x{cols} does not match the frame in map.json ({frame_rows}x{frame_cols})",
         path.display()
     )]
     Shape {
+        /// The layer file concerned.
         path: PathBuf,
+        /// Rows in the layer.
         rows: usize,
+        /// Columns in the layer.
         cols: usize,
+        /// Rows the frame declares.
         frame_rows: usize,
+        /// Columns the frame declares.
         frame_cols: usize,
     },
     /// A value that parses but contradicts the rest of the map.
     #[error("{}: field `{field}`: {message}", path.display())]
     Invalid {
+        /// The file concerned.
         path: PathBuf,
+        /// The offending field, e.g. `regions[2].polygon`, or a layer cell `[row, col]`.
         field: String,
+        /// What is wrong with the value.
         message: String,
     },
 }
@@ -177,7 +203,7 @@ impl From<&Instance> for InstanceRecord {
             label: i.label.clone(),
             label_id: i.label_id,
             num_of_same_class: i.num_of_same_class,
-            color: i.color.clone(),
+            color: i.colour.clone(),
             area: i.area,
             area_m2: i.area_m2,
             bbox: i.bbox,
@@ -200,7 +226,7 @@ impl From<InstanceRecord> for Instance {
             label: r.label,
             label_id: r.label_id,
             num_of_same_class: r.num_of_same_class,
-            color: r.color,
+            colour: r.color,
             area: r.area,
             area_m2: r.area_m2,
             bbox: r.bbox,
@@ -532,7 +558,7 @@ fn check_instances(
                 format!("label {:?} is not among map.json's categories", i.label),
             ));
         }
-        if let Some(c) = &i.color {
+        if let Some(c) = &i.colour {
             if !colours.contains(c) {
                 return Err(PersistError::invalid(
                     path,
@@ -579,7 +605,7 @@ fn check_layers(dir: &Path, map: &IvlMap) -> Result<(), PersistError> {
     // id -> (category id, colour id), for the ids present
     let mut expected: std::collections::HashMap<u32, (u16, u8)> = std::collections::HashMap::new();
     for i in &map.instances {
-        if let (Some(c), Some(v)) = (cat_id(&i.label), col_id(&i.color)) {
+        if let (Some(c), Some(v)) = (cat_id(&i.label), col_id(&i.colour)) {
             expected.insert(i.id, (c, v));
         }
     }

@@ -16,14 +16,19 @@ pub enum ObjectOrder {
     /// By distance from the robot to the footprint, nearest first (the default).
     #[default]
     NearToFar,
+    /// By distance from the robot to the footprint, farthest first.
     FarToNear,
     /// By lateral offset of the footprint centre in the robot's current frame.
     LeftToRight,
+    /// By lateral offset in the robot's current frame, rightmost first.
     RightToLeft,
     /// By the footprint centre's world coordinates.
     NorthToSouth,
+    /// Southernmost footprint centre first.
     SouthToNorth,
+    /// Westernmost footprint centre first.
     WestToEast,
+    /// Easternmost footprint centre first.
     EastToWest,
 }
 
@@ -56,6 +61,7 @@ impl ObjectOrder {
             })
     }
 
+    /// The order's snake_case name, e.g. `near_to_far`.
     pub fn name(self) -> &'static str {
         ObjectOrder::ALL
             .iter()
@@ -103,39 +109,80 @@ pub fn ordinal_word(k: i64) -> String {
 /// A query that the map cannot answer; the message says what the map holds.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum QueryError {
+    /// No label in the map matches the asked name.
     #[error("the map has no {name:?}; it holds {}", holds(.known))]
     UnknownObject {
+        /// The name as asked (trimmed).
         name: String,
+        /// Each label in the map with its instance count.
         known: Vec<(String, usize)>,
     },
+    /// Instances of the label exist, but none of the asked colour.
     #[error("there is no {colour} {name}; {}", colour_summary(.name, .available))]
     NoSuchColour {
+        /// The matched label.
         name: String,
+        /// The colour as asked.
         colour: String,
+        /// Each colour among the label's instances (`None` = unknown) with its count.
         available: Vec<(Option<String>, usize)>,
     },
+    /// No instance matched and the colour is neither a colour word nor a map colour.
     #[error("{colour:?} is not a colour (asked for the {colour} {name}); colours here are {}", .known.join(", "))]
     NotAColour {
+        /// The matched label.
         name: String,
+        /// The word given as the colour.
         colour: String,
+        /// The colour names the map holds.
         known: Vec<String>,
     },
+    /// The asked k-th is past the number of candidates.
     #[error("there {} {count} {what}; asked for the {}", if *.count == 1 { "is" } else { "are" }, ordinal_word(*.k))]
-    OrdinalPastCount { what: String, count: usize, k: i64 },
+    OrdinalPastCount {
+        /// What was counted, e.g. "yellow tables".
+        what: String,
+        /// How many candidates there are.
+        count: usize,
+        /// The ordinal asked for.
+        k: i64,
+    },
+    /// `k` is below -1.
     #[error(
         "ordinal {k} is not valid: use k >= 1 for the k-th, 0 for the nearest, -1 for the last"
     )]
-    BadOrdinal { k: i64 },
+    BadOrdinal {
+        /// The ordinal asked for.
+        k: i64,
+    },
+    /// An order name that [`ObjectOrder::parse`] does not know.
     #[error("unknown order {order:?}; use one of near_to_far, far_to_near, left_to_right, right_to_left, north_to_south, south_to_north, west_to_east, east_to_west")]
-    UnknownOrder { order: String },
+    UnknownOrder {
+        /// The name as given.
+        order: String,
+    },
+    /// No region of the map matches the asked name.
     #[error("the map has no region {name:?}; regions here are {}", if .known.is_empty() { "none".to_string() } else { .known.join(", ") })]
-    UnknownRegion { name: String, known: Vec<String> },
+    UnknownRegion {
+        /// The name as asked.
+        name: String,
+        /// The map's region names.
+        known: Vec<String>,
+    },
+    /// No instance has the asked id.
     #[error("the map has no instance with id {id}")]
-    UnknownInstance { id: u32 },
+    UnknownInstance {
+        /// The id asked for.
+        id: u32,
+    },
+    /// Instances of the label exist, but none has its centroid in the region.
     #[error("there is no {name} in the {region} ({elsewhere} elsewhere on the map)")]
     NoneInRegion {
+        /// The matched label.
         name: String,
+        /// The matched region's name.
         region: String,
+        /// How many instances of the label the map holds outside the region.
         elsewhere: usize,
     },
 }
@@ -265,7 +312,7 @@ impl IvlMap {
                 let want = canonical(c);
                 same.iter()
                     .copied()
-                    .filter(|i| i.color.as_deref().is_some_and(|ic| canonical(ic) == want))
+                    .filter(|i| i.colour.as_deref().is_some_and(|ic| canonical(ic) == want))
                     .collect()
             }
         };
@@ -281,9 +328,9 @@ impl IvlMap {
             }
             let mut available: Vec<(Option<String>, usize)> = Vec::new();
             for i in &same {
-                match available.iter_mut().find(|(col, _)| *col == i.color) {
+                match available.iter_mut().find(|(col, _)| *col == i.colour) {
                     Some((_, n)) => *n += 1,
-                    None => available.push((i.color.clone(), 1)),
+                    None => available.push((i.colour.clone(), 1)),
                 }
             }
             available.sort_by(|a, b| (a.0.is_none(), &a.0).cmp(&(b.0.is_none(), &b.0)));

@@ -74,9 +74,12 @@ pub const MAX_SIDE_PX: u32 = 16_384;
 /// Why a PNG could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
+    /// Saving the PNG to `path` failed.
     #[error("{}: cannot write the PNG: {source}", path.display())]
     Write {
+        /// The file that could not be written.
         path: PathBuf,
+        /// The encoder or I/O error.
         #[source]
         source: image::ImageError,
     },
@@ -336,7 +339,7 @@ fn legend_lines(stops: &[(Pose, String)], width: u32, k: u32) -> Vec<String> {
 
 fn instance_fill(map: &IvlMap, id: u32) -> [u8; 3] {
     map.instance_by_id(id)
-        .and_then(|i| i.color.as_deref())
+        .and_then(|i| i.colour.as_deref())
         .and_then(colour_rgb)
         .unwrap_or(UNKNOWN_RGB)
 }

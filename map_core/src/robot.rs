@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{normalize_heading, Point, Pose};
+use crate::geometry::{normalise_heading, Point, Pose};
 use crate::grid::Grid;
 use crate::map::IvlMap;
 use crate::planner::{inflate_m, GridPlanner, PlanError};
@@ -14,8 +14,11 @@ use crate::planner::{inflate_m, GridPlanner, PlanError};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StopTarget {
+    /// An object instance, by id.
     Instance(u32),
+    /// A named region, by name.
     Region(String),
+    /// A world point `[x, y]` in metres.
     Point([f64; 2]),
     /// Two instances (move_in_between).
     Between([u32; 2]),
@@ -28,6 +31,7 @@ pub struct Stop {
     pub pose: [f64; 3],
     /// The library call that made the move, e.g. "move_to_object".
     pub call: String,
+    /// What the move aimed at.
     pub target: StopTarget,
     /// The goal point asked for, before snapping to a reachable free cell.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -40,12 +44,19 @@ pub struct Stop {
 /// The trajectory file of formats.md.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct Trajectory {
+    /// Name of the scene (map) the run was on.
     pub scene: String,
+    /// Source text of the script that was run.
     pub script: String,
+    /// Stops of the goal-directed moves, in order.
     pub stops: Vec<Stop>,
+    /// The travelled path as `[x, y]` points in metres, from the start position.
     pub path: Vec<[f64; 2]>,
+    /// `[x, y, heading]` at the end of the run.
     pub final_pose: [f64; 3],
+    /// Length of `path` in metres.
     pub length_m: f64,
+    /// The error that ended the run, if any.
     pub error: Option<String>,
 }
 
@@ -92,16 +103,28 @@ pub struct MoveReport {
 /// Why a robot could not do what was asked.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RobotError {
+    /// No path could be planned to the goal.
     #[error(transparent)]
     Plan(#[from] PlanError),
+    /// A goal coordinate, angle or distance was NaN or infinite.
     #[error("{what} must be a finite number, got {value}")]
-    NotFinite { what: &'static str, value: f64 },
+    NotFinite {
+        /// What the number was, e.g. "goal x".
+        what: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// An angle or distance lies outside the accepted range.
     #[error("{what} of {value} is out of range ({range})")]
     OutOfRange {
+        /// What the number was, e.g. "turn angle".
         what: &'static str,
+        /// The value given.
         value: f64,
+        /// The accepted range, in words.
         range: &'static str,
     },
+    /// A robot driver reported a failure (its message).
     #[error("robot driver: {0}")]
     Driver(String),
 }
@@ -111,6 +134,7 @@ pub enum RobotError {
 /// Headings are compass degrees: 0 north, 90 east; `turn(a)` with `a > 0` turns
 /// clockwise (right).
 pub trait Robot {
+    /// The current pose.
     fn pose(&self) -> Pose;
     /// Plan to `goal` and follow the path; records a stop aimed at `target`.
     fn move_to(
@@ -178,10 +202,12 @@ impl SimRobot {
         }
     }
 
+    /// The map the robot moves on.
     pub fn map(&self) -> &Arc<IvlMap> {
         &self.map
     }
 
+    /// The planner it uses (over the map's obstacles inflated by the robot radius).
     pub fn planner(&self) -> &Arc<GridPlanner> {
         &self.planner
     }
@@ -279,7 +305,7 @@ impl Robot for SimRobot {
                 range: "-36000..36000 degrees",
             });
         }
-        self.pose.heading = normalize_heading(self.pose.heading + degrees);
+        self.pose.heading = normalise_heading(self.pose.heading + degrees);
         self.trajectory.final_pose = self.pose.to_array();
         Ok(())
     }
@@ -293,7 +319,7 @@ impl Robot for SimRobot {
                 range: "-36000..36000 degrees",
             });
         }
-        self.pose.heading = normalize_heading(heading);
+        self.pose.heading = normalise_heading(heading);
         self.trajectory.final_pose = self.pose.to_array();
         Ok(())
     }

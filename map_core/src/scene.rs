@@ -18,18 +18,25 @@ pub const SCENE_FORMAT: &str = "ivlmap-scene/1";
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
+    /// Format tag; must be [`SCENE_FORMAT`].
     pub format: String,
+    /// Scene name; the map and trajectories carry it.
     pub name: String,
     /// [xmin, ymin, xmax, ymax] in metres.
     pub bounds: Bounds,
+    /// Grid cell size in metres (default 0.05; 0.005 to 1.0).
     #[serde(default = "default_cell_size")]
     pub cell_size: Positive,
+    /// Wall segments (obstacles without an instance).
     #[serde(default)]
     pub walls: Vec<Wall>,
+    /// Named regions (rooms).
     #[serde(default)]
     pub regions: Vec<SceneRegion>,
+    /// Objects; each becomes an instance of the map.
     #[serde(default)]
     pub objects: Vec<SceneObject>,
+    /// The robot's start pose and radius.
     pub robot: SceneRobot,
 }
 
@@ -120,8 +127,11 @@ impl From<XY> for Point {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Wall {
+    /// One end of the centre line, world metres.
     pub from: XY,
+    /// The other end of the centre line, world metres.
     pub to: XY,
+    /// Thickness in metres (default 0.1).
     #[serde(default = "default_thickness")]
     pub thickness: Positive,
 }
@@ -130,7 +140,9 @@ pub struct Wall {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneRegion {
+    /// Region name, e.g. "kitchen".
     pub name: NonEmpty,
+    /// Outline in world metres.
     pub polygon: PolygonSpec,
 }
 
@@ -179,12 +191,18 @@ impl<'de> Deserialize<'de> for NonEmpty {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneObject {
+    /// Unique object id; becomes the instance id.
     pub id: ObjectId,
+    /// Category name, e.g. "table".
     pub category: NonEmpty,
+    /// Colour word, if known.
     #[serde(default)]
     pub colour: Option<NonEmpty>,
+    /// Footprint centre, world metres.
     pub center: XY,
+    /// Footprint extent [along x, along y] in metres, before rotation.
     pub size: [Positive; 2],
+    /// Footprint rotation in degrees, clockwise (compass sense); 0 when absent.
     #[serde(default)]
     pub yaw: Option<Finite>,
 }
@@ -222,11 +240,14 @@ impl<'de> Deserialize<'de> for ObjectId {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneRobot {
+    /// Start `[x, y, heading]`: metres and compass degrees.
     pub pose: [Finite; 3],
+    /// Robot radius in metres.
     pub radius: Positive,
 }
 
 impl SceneRobot {
+    /// The start pose, heading normalised.
     pub fn pose(&self) -> Pose {
         Pose::new(self.pose[0].0, self.pose[1].0, self.pose[2].0)
     }
@@ -235,9 +256,11 @@ impl SceneRobot {
 /// Where a scene problem is.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct SceneLocation {
+    /// The scene file (or the name the source was given).
     pub file: PathBuf,
     /// 1-based line and column, where the JSON reader knows them.
     pub line: Option<usize>,
+    /// 1-based column, where known.
     pub column: Option<usize>,
     /// Field path, e.g. `objects[2].size[0]`.
     pub field: String,
@@ -273,14 +296,23 @@ pub(crate) fn write_position(
 /// A scene that could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// The scene file could not be read.
     #[error("{}: cannot read scene file: {source}", path.display())]
     Io {
+        /// The scene file concerned.
         path: PathBuf,
+        /// The underlying I/O error.
         #[source]
         source: std::io::Error,
     },
+    /// The JSON is malformed or breaks a scene rule.
     #[error("{at}: {message}")]
-    Invalid { at: SceneLocation, message: String },
+    Invalid {
+        /// Where the problem is.
+        at: SceneLocation,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 impl SceneError {

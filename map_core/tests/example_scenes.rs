@@ -11,7 +11,8 @@
 use std::collections::{HashMap, VecDeque};
 use std::path::PathBuf;
 
-use map_core::{inflate, Cell, Grid, GridFrame, GridPlanner, IvlMap, Point, Scene};
+use map_core::planner::inflate;
+use map_core::{Cell, Grid, GridFrame, GridPlanner, IvlMap, Point, Scene};
 
 fn scene_paths() -> Vec<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/scenes");
@@ -170,7 +171,7 @@ fn example_scenes_are_valid_reachable_and_varied() {
                 "{name}: object {} ({} {:?}) has no reachable free cell within 0.5 m",
                 inst.id,
                 inst.label,
-                inst.color
+                inst.colour
             );
             // the planner agrees
             assert!(
@@ -242,7 +243,7 @@ fn example_scenes_are_valid_reachable_and_varied() {
                 .instances
                 .iter()
                 .filter(|i| &i.label == label)
-                .filter_map(|i| i.color.clone())
+                .filter_map(|i| i.colour.clone())
                 .collect();
             cols.sort();
             cols.dedup();

@@ -7,7 +7,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use map_core::{write_npy, Grid, IvlMap, PersistError, Scene};
+use map_core::npy::write_npy;
+use map_core::persist::PersistError;
+use map_core::{Grid, IvlMap, Scene};
 
 fn scene_path(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

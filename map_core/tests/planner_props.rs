@@ -1,48 +1,17 @@
 //! Property tests of the grid planner on random cluttered grids, each checked
 //! against independent reference code written here: a breadth-first flood fill, a
-//! textbook Dijkstra, an exact segment/square intersection test and brute-force
+//! Dijkstra (the `pathfinding` crate), an exact segment/square intersection test and brute-force
 //! nearest-cell searches.
 
-use std::cmp::Reverse;
-use std::collections::{BinaryHeap, VecDeque};
+use std::collections::VecDeque;
 
-use map_core::{astar, inflate, Cell, Grid, GridPlanner, PlanError};
+use map_core::planner::{astar, inflate};
+use map_core::{Cell, Grid, GridPlanner, PlanError};
 use proptest::prelude::*;
 
-const MOVES: [(isize, isize); 8] = [
-    (-1, 0),
-    (1, 0),
-    (0, -1),
-    (0, 1),
-    (-1, -1),
-    (-1, 1),
-    (1, -1),
-    (1, 1),
-];
-
-fn free(g: &Grid<bool>, r: isize, c: isize) -> bool {
-    r >= 0 && c >= 0 && g.get(Cell::new(r as usize, c as usize)) == Some(&false)
-}
-
-/// Legal 8-connected moves: no corner cutting past an occupied cell.
-fn neighbours(g: &Grid<bool>, cell: Cell) -> Vec<(Cell, f64)> {
-    let (r, c) = (cell.row as isize, cell.col as isize);
-    MOVES
-        .iter()
-        .filter(|&&(dr, dc)| {
-            free(g, r + dr, c + dc)
-                && (dr == 0 || dc == 0 || (free(g, r + dr, c) && free(g, r, c + dc)))
-        })
-        .map(|&(dr, dc)| {
-            let cost = if dr != 0 && dc != 0 {
-                std::f64::consts::SQRT_2
-            } else {
-                1.0
-            };
-            (Cell::new((r + dr) as usize, (c + dc) as usize), cost)
-        })
-        .collect()
-}
+#[path = "common/reference.rs"]
+mod reference;
+use reference::{dijkstra, neighbours};
 
 fn flood(g: &Grid<bool>, s: Cell) -> Grid<bool> {
     let mut seen = Grid::new(g.rows(), g.cols(), false);
@@ -57,29 +26,6 @@ fn flood(g: &Grid<bool>, s: Cell) -> Grid<bool> {
         }
     }
     seen
-}
-
-fn dijkstra(g: &Grid<bool>, s: Cell, t: Cell) -> Option<f64> {
-    let mut dist = Grid::new(g.rows(), g.cols(), f64::INFINITY);
-    let mut heap = BinaryHeap::new();
-    dist.set(s, 0.0);
-    heap.push(Reverse((0u64, s.row, s.col)));
-    while let Some(Reverse((d, r, c))) = heap.pop() {
-        let (d, cell) = (f64::from_bits(d), Cell::new(r, c));
-        if d > dist.get(cell).copied().unwrap_or(f64::INFINITY) {
-            continue;
-        }
-        if cell == t {
-            return Some(d);
-        }
-        for (n, w) in neighbours(g, cell) {
-            if d + w < dist.get(n).copied().unwrap_or(0.0) {
-                dist.set(n, d + w);
-                heap.push(Reverse(((d + w).to_bits(), n.row, n.col)));
-            }
-        }
-    }
-    None
 }
 
 /// Exact test: does the segment between the centres of `a` and `b` touch the closed

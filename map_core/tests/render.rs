@@ -6,10 +6,11 @@
 
 use std::path::PathBuf;
 
-use map_core::{
-    auto_scale, colour_rgb, render_png, render_rgb, IvlMap, Point, Pose, RenderOptions,
-    RenderOverlay, Scene, PATH_RGB, STOP_RGB, UNKNOWN_RGB, WALL_RGB,
+use map_core::render::{
+    auto_scale, colour_rgb, render_png, render_rgb, RenderOptions, RenderOverlay, PATH_RGB,
+    STOP_RGB, UNKNOWN_RGB, WALL_RGB,
 };
+use map_core::{IvlMap, Point, Pose, Scene};
 
 fn map(name: &str) -> IvlMap {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -65,7 +66,7 @@ fn instances_are_filled_with_their_colour_and_walls_are_dark() {
     let img = render_rgb(&m, &RenderOverlay::default(), &opts);
     for inst in &m.instances {
         let want = inst
-            .color
+            .colour
             .as_deref()
             .and_then(colour_rgb)
             .unwrap_or(UNKNOWN_RGB);
@@ -75,12 +76,12 @@ fn instances_are_filled_with_their_colour_and_walls_are_dark() {
             "instance {} ({} {:?})",
             inst.id,
             inst.label,
-            inst.color
+            inst.colour
         );
     }
     // red sofa, yellow table, the outer south wall, a free floor cell
     let sofa = m.instance_by_id(1).unwrap();
-    assert_eq!(sofa.color.as_deref(), Some("red"));
+    assert_eq!(sofa.colour.as_deref(), Some("red"));
     assert_eq!(pixel_at(&img, &m, s, sofa.center()), [214, 39, 40]);
     assert_eq!(pixel_at(&img, &m, s, Point::new(3.0, 0.1)), WALL_RGB);
     assert_eq!(pixel_at(&img, &m, s, Point::new(4.0, 3.5)), [255, 255, 255]);
@@ -148,9 +149,9 @@ fn path_stops_and_final_pose_are_drawn() {
     let fc = m.frame.cell_at(Point::new(9.4, 4.5)).unwrap();
     let tip_x = fc.col as u32 * s + s / 2 + 10;
     let row = fc.row as u32 * s + s / 2;
-    assert_eq!(img.get_pixel(tip_x, row).0, map_core::FINAL_RGB);
+    assert_eq!(img.get_pixel(tip_x, row).0, map_core::render::FINAL_RGB);
     let west_x = fc.col as u32 * s + s / 2 - 12;
-    assert_ne!(img.get_pixel(west_x, row).0, map_core::FINAL_RGB);
+    assert_ne!(img.get_pixel(west_x, row).0, map_core::render::FINAL_RGB);
 }
 
 #[test]

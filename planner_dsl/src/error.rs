@@ -15,7 +15,9 @@ pub struct Span {
 }
 
 impl Span {
-    pub(crate) fn from_position(pos: rhai::Position) -> Span {
+    /// The span of a Rhai position (0, 0 when it has none).
+    #[must_use]
+    pub fn from_position(pos: rhai::Position) -> Span {
         Span {
             line: pos.line().unwrap_or(0),
             col: pos.position().unwrap_or(0),

@@ -66,6 +66,8 @@
 //! println!("{err}");
 //! ```
 
+#![warn(missing_docs)]
+
 mod engine;
 mod error;
 mod exec;

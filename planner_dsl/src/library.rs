@@ -6,10 +6,12 @@ use crate::limits::Limits;
 use crate::registry::{FunctionSpec, ParamType};
 use crate::trace::TraceEntry;
 use crate::value::{point_to_dynamic, to_json, type_word, ObjectRecord};
-use map_core::{
+use map_core::goals::{
     approach_point, between_point, face_heading, heading_with_object_on, lateral_point,
-    region_point, side_point, Instance, IvlMap, ObjectOrder, Point, QueryError, Region, Robot,
-    RobotError, Side, StopTarget,
+    region_point, side_point, Side,
+};
+use map_core::{
+    Instance, IvlMap, ObjectOrder, Point, QueryError, Region, Robot, RobotError, StopTarget,
 };
 use rhai::Dynamic;
 use std::time::Instant;
@@ -113,7 +115,7 @@ pub(crate) fn record(inst: &Instance) -> ObjectRecord {
         id: inst.id,
         name: inst.label.clone(),
         label_id: inst.label_id,
-        colour: inst.color.clone(),
+        colour: inst.colour.clone(),
         position: [c.x, c.y],
         count: inst.num_of_same_class,
     }
@@ -329,14 +331,14 @@ impl<'a> Host<'a> {
             }
             "move_forward" => {
                 let d = self.number_arg(spec, 0, &args[0])?;
-                if d.abs() > map_core::MAX_FORWARD_M {
+                if d.abs() > map_core::robot::MAX_FORWARD_M {
                     return Err(arg_err(
                         spec,
                         0,
                         format!(
                             "of {} m is absurd (limit ±{} m)",
                             num(d),
-                            map_core::MAX_FORWARD_M
+                            map_core::robot::MAX_FORWARD_M
                         ),
                     ));
                 }

@@ -34,26 +34,11 @@ fn forbidden(name: &str) -> Option<&'static str> {
     FORBIDDEN.iter().find(|(n, _)| *n == name).map(|(_, r)| *r)
 }
 
-/// Edit distance (Levenshtein), for "did you mean" hints.
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1; b.len() + 1];
-        for (j, cb) in b.iter().enumerate() {
-            let sub = prev[j] + usize::from(ca != *cb);
-            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
-        }
-        prev = cur;
-    }
-    prev[b.len()]
-}
-
 fn suggestion(name: &str) -> Option<String> {
     let lib = registry().iter().map(|f| f.name);
     let best = lib
         .chain(BUILTIN_ALLOW_LIST.iter().copied())
-        .map(|c| (edit_distance(name, c), c))
+        .map(|c| (strsim::levenshtein(name, c), c))
         .min_by_key(|(d, _)| *d)?;
     let len = name.chars().count();
     let limit = (len / 3).clamp(1, 4);
@@ -362,8 +347,8 @@ mod tests {
 
     #[test]
     fn edit_distance_and_suggestions() {
-        assert_eq!(edit_distance("kitten", "sitting"), 3);
-        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(strsim::levenshtein("kitten", "sitting"), 3);
+        assert_eq!(strsim::levenshtein("", "abc"), 3);
         assert_eq!(
             suggestion("move_to_objct").as_deref(),
             Some("did you mean `move_to_object`?")

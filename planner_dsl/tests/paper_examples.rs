@@ -195,12 +195,12 @@ say(`done: ${table.colour} table #${table.label_id}`);"#,
     let after = out.trace[3].pose_after;
     let c = map.instance_by_id(1).unwrap().center();
     let bearing = map_core::Point::new(after[0], after[1]).heading_to(c);
-    let rel = map_core::normalize_heading(bearing - after[2]);
+    let rel = map_core::geometry::normalise_heading(bearing - after[2]);
     assert!((rel - 90.0).abs() < 1e-6, "{rel}");
     // turn(90) turns right by 90 degrees.
     let before_turn = out.trace[5].pose_after[2];
     let after_turn = out.trace[6].pose_after[2];
-    assert!((map_core::normalize_heading(after_turn - before_turn) - 90.0).abs() < 1e-6);
+    assert!((map_core::geometry::normalise_heading(after_turn - before_turn) - 90.0).abs() < 1e-6);
     assert_eq!(out.said.len(), 1);
     assert!(out.said[0].starts_with("done: "), "{}", out.said[0]);
     assert_eq!(robot.trajectory().stops.len(), 3);

@@ -120,7 +120,7 @@ fn trace_records_calls_and_round_trips_through_json() {
 fn object_record_fields_are_readable() {
     let (map, mut robot) = world("office-b");
     let plan = Plan::compile(
-        "let t = agent.get_obj_attributes(\"table\", -1, \"yellow\", \"west_to_east\");\nsay(`${t.name} ${t.colour} ${t.color} ${t.label_id} ${t.id} ${t.count} ${t.position[0]}`);",
+        "let t = agent.get_obj_attributes(\"table\", -1, \"yellow\", \"west_to_east\");\nsay(`${t.name} ${t.colour} ${t.colour} ${t.label_id} ${t.id} ${t.count} ${t.position[0]}`);",
     )
     .unwrap();
     let out = run(&plan, &map, &mut robot, &Limits::default());

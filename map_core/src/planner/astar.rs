@@ -46,16 +46,7 @@ pub fn astar<P: Passability + ?Sized>(
             return Some((path, g[i]));
         }
         let (r, c) = (cell.row as isize, cell.col as isize);
-        for (dr, dc) in [
-            (-1, 0),
-            (1, 0),
-            (0, -1),
-            (0, 1),
-            (-1, -1),
-            (-1, 1),
-            (1, -1),
-            (1, 1),
-        ] {
+        for (dr, dc) in super::MOVES8 {
             let (nr, nc) = (r + dr, c + dc);
             if !free(nr, nc) || (dr != 0 && dc != 0 && !(free(r + dr, c) && free(r, c + dc))) {
                 continue;

@@ -256,16 +256,7 @@ pub(crate) fn search(
         let mut nd = 0;
         let par = s.parent[i] as usize;
         if par == i {
-            for d in [
-                (-1, 0),
-                (1, 0),
-                (0, -1),
-                (0, 1),
-                (-1, -1),
-                (-1, 1),
-                (1, -1),
-                (1, 1),
-            ] {
+            for d in super::MOVES8 {
                 dirs[nd] = d;
                 nd += 1;
             }

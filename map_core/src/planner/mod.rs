@@ -8,7 +8,8 @@
 //! snapping), after which unreachable goals are refused without a search.
 //!
 //! ```
-//! use map_core::{Cell, Grid, GridPlanner, inflate};
+//! use map_core::{Cell, Grid, GridPlanner};
+//! use map_core::planner::inflate;
 //! let mut obstacles = Grid::new(40, 40, false);
 //! for r in 0..30 { obstacles.set(Cell::new(r, 20), true); } // a wall with a gap at the bottom
 //! let planner = GridPlanner::new(inflate(&obstacles, 2.0));
@@ -30,13 +31,27 @@ use std::sync::{Mutex, OnceLock};
 use crate::geometry::Point;
 use crate::grid::{Cell, Grid, GridFrame};
 
+/// The eight grid moves as (row, column) offsets: the four sides, then the diagonals.
+pub const MOVES8: [(isize, isize); 8] = [
+    (-1, 0),
+    (1, 0),
+    (0, -1),
+    (0, 1),
+    (-1, -1),
+    (-1, 1),
+    (1, -1),
+    (1, 1),
+];
+
 pub use astar::astar;
 pub use inflate::{inflate, inflate_m};
 pub use line_of_sight::{line_of_sight, supercover_cells};
 
 /// A map the planner can search: its size and which cells a robot centre may occupy.
 pub trait Passability {
+    /// Number of rows (north to south).
     fn rows(&self) -> usize;
+    /// Number of columns (west to east).
     fn cols(&self) -> usize;
     /// Whether the cell is free; out-of-bounds cells are never free.
     fn is_free(&self, c: Cell) -> bool;
@@ -58,42 +73,71 @@ impl Passability for Grid<bool> {
 /// Why no path could be planned.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PlanError {
+    /// No path joins the (snapped) start to the goal.
     #[error("goal {} is unreachable from start {}", describe(.goal, .goal_world), describe(.start, .start_world))]
     Unreachable {
+        /// The start cell as asked.
         start: Cell,
+        /// The goal cell as asked.
         goal: Cell,
+        /// The start point in world metres, when planning in the world frame.
         start_world: Option<Point>,
+        /// The goal point in world metres, when planning in the world frame.
         goal_world: Option<Point>,
     },
+    /// The start cell lies outside the grid.
     #[error("start cell (row {}, col {}) lies outside the {rows}x{cols} grid", .start.row, .start.col)]
     StartOutside {
+        /// The start cell as asked.
         start: Cell,
+        /// Rows in the grid.
         rows: usize,
+        /// Columns in the grid.
         cols: usize,
     },
+    /// The goal cell lies outside the grid.
     #[error("goal cell (row {}, col {}) lies outside the {rows}x{cols} grid", .goal.row, .goal.col)]
     GoalOutside {
+        /// The goal cell as asked.
         goal: Cell,
+        /// Rows in the grid.
         rows: usize,
+        /// Columns in the grid.
         cols: usize,
     },
+    /// A world start or goal point lies outside the frame's bounds.
     #[error("{what} point ({}, {}) lies outside the map bounds {bounds:?}", .point.x, .point.y)]
     PointOutside {
+        /// Which point: "start" or "goal".
         what: &'static str,
+        /// The point, in world metres.
         point: Point,
+        /// The frame's [xmin, ymin, xmax, ymax] in metres.
         bounds: [f64; 4],
     },
+    /// A world start or goal point has a NaN or infinite coordinate.
     #[error("{what} point is not finite: ({}, {})", .point.x, .point.y)]
-    NonFinite { what: &'static str, point: Point },
+    NonFinite {
+        /// Which point: "start" or "goal".
+        what: &'static str,
+        /// The point as given.
+        point: Point,
+    },
+    /// The frame given to [`GridPlanner::plan_world`] differs in size from the planner's grid.
     #[error(
         "the map frame ({frame_rows}x{frame_cols}) does not match the planner grid ({rows}x{cols})"
     )]
     FrameMismatch {
+        /// Rows in the frame.
         frame_rows: usize,
+        /// Columns in the frame.
         frame_cols: usize,
+        /// Rows in the planner's grid.
         rows: usize,
+        /// Columns in the planner's grid.
         cols: usize,
     },
+    /// The map has no free cell to snap the start or goal to.
     #[error("the map has no free cell")]
     NoFreeCell,
 }
@@ -120,10 +164,12 @@ pub struct GridPath {
     pub smoothed_len: f64,
     /// Start as asked and as used (differs when the start lay in an obstacle).
     pub start: Cell,
+    /// Whether the start lay in an obstacle and was moved to the nearest free cell.
     pub start_snapped: bool,
     /// Goal as used: the nearest free cell reachable from the start when the asked
     /// goal lay in an obstacle.
     pub goal: Cell,
+    /// Whether the goal lay in an obstacle and was moved.
     pub goal_snapped: bool,
 }
 
@@ -133,8 +179,11 @@ pub struct WorldPath {
     /// From the start point (or the centre of its snapped cell) to the goal point
     /// (or the centre of its snapped cell).
     pub waypoints: Vec<Point>,
+    /// Length of `waypoints` in metres.
     pub length_m: f64,
+    /// Whether the start lay in an obstacle and was moved to the nearest free cell.
     pub start_snapped: bool,
+    /// Whether the goal lay in an obstacle and was moved.
     pub goal_snapped: bool,
     /// The goal actually reached: the asked point unless it was snapped.
     pub goal: Point,
@@ -260,10 +309,12 @@ impl GridPlanner {
         self.labels.get_or_init(|| components::label(&self.map))
     }
 
+    /// Number of rows in the planner's grid.
     pub fn rows(&self) -> usize {
         self.map.rows
     }
 
+    /// Number of columns in the planner's grid.
     pub fn cols(&self) -> usize {
         self.map.cols
     }

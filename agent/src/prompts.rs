@@ -1,0 +1,424 @@
+//! Prompt templates: plain files rendered with minijinja.
+//!
+//! The default set lives in the repository's `prompts/` folder and is also compiled into
+//! the binary ([`Prompts::builtin`]). A variant is a folder holding some of the same files:
+//! [`Prompts::load`] starts from the built-in set and overlays the folder's files, so a
+//! variant only contains what it changes. [`Prompts::load_variant`] overlays a variant onto
+//! a default folder on disk.
+//!
+//! Templates and what they receive:
+//! - `system.md.j2`: the framing shared by both steps (no variables).
+//! - `attributes.md.j2`: step 1's task and examples (no variables).
+//! - `extract_request.md.j2`: step 1's user message: `instruction`, `scene`.
+//! - `functions.md.j2`: `functions` (generated from planner_dsl's registry, never copied by
+//!   hand) and `registry` (a list of `{name, signature, doc, example}`).
+//! - `examples.md.j2`, `codegen.md.j2`: step 2's worked examples and rules (no variables).
+//! - `plan_request.md.j2`: step 2's user message: `instruction`, `tuples` (the paper's
+//!   notation), `tuple_list` (structured), `scene` (a one-line summary of the map),
+//!   `history` (a summary of the conversation so far).
+//! - `repair.md.j2`: the repair feedback: `errors` (a list of messages with positions).
+//!
+//! Step 1's system message is `system` + `attributes`; step 2's is `system` + `functions` +
+//! `examples` + `codegen`. Both are identical for every instruction, so a backend with
+//! prefix caching reuses them; everything that varies (the scene, the history, the
+//! instruction) is in the final user message.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use minijinja::value::Serde;
+use minijinja::{Environment, UndefinedBehavior, Value};
+use serde::Serialize;
+
+use llm::ChatMessage;
+
+use crate::tuples::{tuples_paper_form, Tuple};
+
+/// The template files every prompt set has.
+pub const TEMPLATE_NAMES: &[&str] = &[
+    "system.md.j2",
+    "attributes.md.j2",
+    "extract_request.md.j2",
+    "functions.md.j2",
+    "examples.md.j2",
+    "codegen.md.j2",
+    "plan_request.md.j2",
+    "repair.md.j2",
+];
+
+const BUILTIN: &[(&str, &str)] = &[
+    ("system.md.j2", include_str!("../../prompts/system.md.j2")),
+    (
+        "attributes.md.j2",
+        include_str!("../../prompts/attributes.md.j2"),
+    ),
+    (
+        "extract_request.md.j2",
+        include_str!("../../prompts/extract_request.md.j2"),
+    ),
+    (
+        "functions.md.j2",
+        include_str!("../../prompts/functions.md.j2"),
+    ),
+    (
+        "examples.md.j2",
+        include_str!("../../prompts/examples.md.j2"),
+    ),
+    ("codegen.md.j2", include_str!("../../prompts/codegen.md.j2")),
+    (
+        "plan_request.md.j2",
+        include_str!("../../prompts/plan_request.md.j2"),
+    ),
+    ("repair.md.j2", include_str!("../../prompts/repair.md.j2")),
+];
+
+/// A prompt file that could not be read or rendered.
+#[derive(Debug, thiserror::Error)]
+pub enum PromptError {
+    /// A folder or file could not be read.
+    #[error("prompt folder {}: {message}", path.display())]
+    Io {
+        /// The folder or file.
+        path: PathBuf,
+        /// What failed.
+        message: String,
+    },
+    /// A file is not one of the known templates (likely a typo in its name).
+    #[error("{}: not a prompt template name; expected one of {}", path.display(), TEMPLATE_NAMES.join(", "))]
+    UnknownFile {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A template failed to parse or render.
+    #[error("prompt template {origin}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Template {
+        /// Where the template came from (a file path or "built-in name").
+        origin: String,
+        /// The line in the template, when minijinja knows it.
+        line: Option<usize>,
+        /// minijinja's message.
+        message: String,
+    },
+}
+
+/// A set of prompt templates (the built-in defaults, possibly overlaid by folders).
+#[derive(Debug, Clone)]
+pub struct Prompts {
+    templates: BTreeMap<String, (String, String)>,
+    label: String,
+}
+
+impl Default for Prompts {
+    fn default() -> Self {
+        Self::builtin()
+    }
+}
+
+/// One function of the library as templates see it.
+#[derive(Debug, Clone, Serialize)]
+struct FnView {
+    name: &'static str,
+    signature: String,
+    doc: &'static str,
+    example: &'static str,
+}
+
+impl Prompts {
+    /// The default templates compiled into the crate (the repository's `prompts/`).
+    #[must_use]
+    pub fn builtin() -> Self {
+        let templates = BUILTIN
+            .iter()
+            .map(|(n, s)| {
+                (
+                    (*n).to_string(),
+                    ((*s).to_string(), format!("built-in {n}")),
+                )
+            })
+            .collect();
+        Self {
+            templates,
+            label: "builtin".into(),
+        }
+    }
+
+    /// The built-in set overlaid with the template files in `dir` (a full prompt folder or
+    /// a variant holding only some files).
+    ///
+    /// # Errors
+    /// [`PromptError`] when the folder cannot be read, holds a `.j2` file with an unknown
+    /// name, or a template does not parse.
+    pub fn load(dir: impl AsRef<Path>) -> Result<Self, PromptError> {
+        Self::builtin().overlay(dir)
+    }
+
+    /// `default_dir`'s templates (over the built-in set), then `variant_dir`'s on top.
+    ///
+    /// # Errors
+    /// As [`Prompts::load`], for either folder.
+    pub fn load_variant(
+        default_dir: impl AsRef<Path>,
+        variant_dir: impl AsRef<Path>,
+    ) -> Result<Self, PromptError> {
+        Self::load(default_dir)?.overlay(variant_dir)
+    }
+
+    /// This set with the template files of `dir` replacing those of the same name.
+    ///
+    /// # Errors
+    /// As [`Prompts::load`].
+    pub fn overlay(mut self, dir: impl AsRef<Path>) -> Result<Self, PromptError> {
+        let dir = dir.as_ref();
+        let io = |path: &Path, e: std::io::Error| PromptError::Io {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map_err(|e| io(dir, e))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "j2"))
+            .collect();
+        entries.sort();
+        for path in entries {
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().to_string())
+                .unwrap_or_default();
+            if !TEMPLATE_NAMES.contains(&name.as_str()) {
+                return Err(PromptError::UnknownFile { path });
+            }
+            let text = std::fs::read_to_string(&path).map_err(|e| io(&path, e))?;
+            self.templates
+                .insert(name, (text, path.display().to_string()));
+        }
+        self.label = dir.display().to_string();
+        self.check()?;
+        Ok(self)
+    }
+
+    /// A short description of where the set came from ("builtin" or the last folder).
+    #[must_use]
+    pub fn label(&self) -> &str {
+        &self.label
+    }
+
+    /// The source text of a template.
+    #[must_use]
+    pub fn source(&self, name: &str) -> Option<&str> {
+        self.templates.get(name).map(|(s, _)| s.as_str())
+    }
+
+    /// Where a template came from (a file path, or "built-in NAME").
+    #[must_use]
+    pub fn origin(&self, name: &str) -> Option<&str> {
+        self.templates.get(name).map(|(_, o)| o.as_str())
+    }
+
+    /// Parses every template (so that a broken variant fails at load time).
+    fn check(&self) -> Result<(), PromptError> {
+        for name in self.templates.keys() {
+            self.env(name)?;
+        }
+        Ok(())
+    }
+
+    fn template_error(&self, name: &str, e: &minijinja::Error) -> PromptError {
+        let mut message = e.to_string();
+        let mut src = std::error::Error::source(e);
+        while let Some(s) = src {
+            message.push_str(&format!(": {s}"));
+            src = s.source();
+        }
+        PromptError::Template {
+            origin: self.origin(name).unwrap_or(name).to_string(),
+            line: e.line(),
+            message,
+        }
+    }
+
+    fn env(&self, name: &str) -> Result<Environment<'static>, PromptError> {
+        let mut env = Environment::new();
+        env.set_undefined_behavior(UndefinedBehavior::SemiStrict);
+        let (src, _) = self
+            .templates
+            .get(name)
+            .ok_or_else(|| PromptError::Template {
+                origin: name.to_string(),
+                line: None,
+                message: "no such template".into(),
+            })?;
+        env.add_template_owned(name.to_string(), src.clone())
+            .map_err(|e| self.template_error(name, &e))?;
+        Ok(env)
+    }
+
+    /// Renders one template with `ctx` (a minijinja value, e.g. from `minijinja::context!`).
+    /// Trailing whitespace is trimmed.
+    ///
+    /// # Errors
+    /// [`PromptError::Template`] with the template's origin and line.
+    pub fn render(&self, name: &str, ctx: Value) -> Result<String, PromptError> {
+        let env = self.env(name)?;
+        let tmpl = env
+            .get_template(name)
+            .map_err(|e| self.template_error(name, &e))?;
+        let out = tmpl
+            .render(ctx)
+            .map_err(|e| self.template_error(name, &e))?;
+        Ok(out.trim_end().to_string())
+    }
+
+    fn functions_ctx() -> Value {
+        let registry: Vec<FnView> = planner_dsl::registry()
+            .iter()
+            .map(|f| FnView {
+                name: f.name,
+                signature: f.signature(),
+                doc: f.doc,
+                example: f.example,
+            })
+            .collect();
+        minijinja::context! {
+            functions => planner_dsl::function_list_for_prompt().trim_end(),
+            registry => Value::from(Serde(&registry)),
+        }
+    }
+
+    /// Step 1's system message: `system` + `attributes` (identical for every instruction).
+    ///
+    /// # Errors
+    /// [`PromptError::Template`].
+    pub fn extract_system(&self) -> Result<String, PromptError> {
+        let empty = minijinja::context! {};
+        Ok(format!(
+            "{}\n\n{}",
+            self.render("system.md.j2", empty.clone())?,
+            self.render("attributes.md.j2", empty)?
+        ))
+    }
+
+    /// Step 1's messages for `instruction`.
+    ///
+    /// # Errors
+    /// [`PromptError::Template`].
+    pub fn extract_messages(
+        &self,
+        instruction: &str,
+        scene: Option<&str>,
+    ) -> Result<Vec<ChatMessage>, PromptError> {
+        let user = self.render(
+            "extract_request.md.j2",
+            minijinja::context! { instruction => instruction.trim(), scene => scene },
+        )?;
+        Ok(vec![
+            ChatMessage::system(self.extract_system()?),
+            ChatMessage::user(user),
+        ])
+    }
+
+    /// Step 2's system message: `system` + `functions` + `examples` + `codegen`.
+    ///
+    /// # Errors
+    /// [`PromptError::Template`].
+    pub fn plan_system(&self) -> Result<String, PromptError> {
+        let empty = minijinja::context! {};
+        Ok(format!(
+            "{}\n\n{}\n\n{}\n\n{}",
+            self.render("system.md.j2", empty.clone())?,
+            self.render("functions.md.j2", Self::functions_ctx())?,
+            self.render("examples.md.j2", empty.clone())?,
+            self.render("codegen.md.j2", empty)?
+        ))
+    }
+
+    /// Step 2's messages: the shared system message, then one user message with the scene,
+    /// the conversation summary, the instruction and its tuples.
+    ///
+    /// # Errors
+    /// [`PromptError::Template`].
+    pub fn plan_messages(
+        &self,
+        instruction: &str,
+        tuples: &[Tuple],
+        scene: Option<&str>,
+        history: Option<&str>,
+    ) -> Result<Vec<ChatMessage>, PromptError> {
+        let user = self.render(
+            "plan_request.md.j2",
+            minijinja::context! {
+                instruction => instruction.trim(),
+                tuples => tuples_paper_form(tuples),
+                tuple_list => Value::from(Serde(tuples)),
+                scene => scene,
+                history => history,
+            },
+        )?;
+        Ok(vec![
+            ChatMessage::system(self.plan_system()?),
+            ChatMessage::user(user),
+        ])
+    }
+
+    /// The user message that sends errors back to the model.
+    ///
+    /// # Errors
+    /// [`PromptError::Template`].
+    pub fn repair_message(&self, errors: &[String]) -> Result<ChatMessage, PromptError> {
+        Ok(ChatMessage::user(self.render(
+            "repair.md.j2",
+            minijinja::context! { errors => Value::from(Serde(errors)) },
+        )?))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builtin_set_is_complete_and_renders() {
+        let p = Prompts::builtin();
+        for n in TEMPLATE_NAMES {
+            assert!(p.source(n).is_some(), "{n}");
+        }
+        let sys = p.plan_system().unwrap();
+        for f in planner_dsl::registry() {
+            assert!(
+                sys.contains(&format!("agent.{}(", f.name)),
+                "{} missing",
+                f.name
+            );
+        }
+        let m = p
+            .plan_messages(
+                "go to the red sofa",
+                &[Tuple::new("sofa", None, Some("red"))],
+                Some("1 sofa (red)"),
+                None,
+            )
+            .unwrap();
+        assert!(
+            m[1].content.contains("Objects: [(sofa, None, red)]"),
+            "{}",
+            m[1].content
+        );
+        assert!(
+            m[1].content.starts_with("Map: 1 sofa (red)"),
+            "{}",
+            m[1].content
+        );
+        assert!(!m[1].content.contains("Earlier"), "{}", m[1].content);
+    }
+
+    #[test]
+    fn repair_lists_errors() {
+        let m = Prompts::builtin()
+            .repair_message(&["line 1, column 5: boom".into(), "x".into()])
+            .unwrap();
+        assert!(
+            m.content.contains("- line 1, column 5: boom\n- x"),
+            "{}",
+            m.content
+        );
+    }
+}

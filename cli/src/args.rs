@@ -1,0 +1,221 @@
+//! The command line: clap's derive types for every subcommand and the backend flags.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use agent::PlanOptions;
+
+use crate::backend::BackendChoice;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "ivlmap",
+    version,
+    about = "Language to robot plans on an instance-level semantic map (IVLMap)"
+)]
+pub(crate) struct Cli {
+    /// More log output on stderr (-v info, -vv debug, -vvv trace); RUST_LOG overrides.
+    #[arg(short, long, action = clap::ArgAction::Count, global = true)]
+    pub(crate) verbose: u8,
+    #[command(subcommand)]
+    pub(crate) command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub(crate) enum Command {
+    /// Chat with the robot: each instruction is planned, shown and executed.
+    Chat {
+        /// Scene file (.scene.json) or saved map folder.
+        #[arg(long)]
+        scene: PathBuf,
+        #[command(flatten)]
+        backend: BackendArgs,
+        /// Prompt folder (a variant overlaying the built-in templates).
+        #[arg(long)]
+        prompts: Option<PathBuf>,
+    },
+    /// Run a mission unattended: a .rhai plan or a list of instructions (one per line, # comments).
+    Run {
+        /// The mission file.
+        mission: PathBuf,
+        /// Scene file or map folder (default: the mission's `scene:` header comment).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Write the trajectory JSON here (also when the mission fails part-way).
+        #[arg(long)]
+        trajectory: Option<PathBuf>,
+        /// Draw the map with the trajectory to this PNG.
+        #[arg(long)]
+        png: Option<PathBuf>,
+        #[command(flatten)]
+        backend: BackendArgs,
+        /// Prompt folder (a variant overlaying the built-in templates).
+        #[arg(long)]
+        prompts: Option<PathBuf>,
+    },
+    /// Show the tuples and the script for an instruction; run nothing.
+    Plan {
+        /// The instruction.
+        instruction: String,
+        /// Scene file or map folder.
+        #[arg(long)]
+        scene: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        backend: BackendArgs,
+        /// Prompt folder (a variant overlaying the built-in templates).
+        #[arg(long)]
+        prompts: Option<PathBuf>,
+    },
+    /// Evaluate an extraction (.extract.jsonl) or navigation (.nav.jsonl) suite.
+    Eval {
+        /// The suite file.
+        suite: PathBuf,
+        /// Backend(s); several give a side-by-side table.
+        #[arg(long = "backend", value_name = "B", default_value = "llama")]
+        backends: Vec<String>,
+        #[command(flatten)]
+        model_args: ModelArgs,
+        /// Prompt variant folder(s); several give a side-by-side table (default: built-in).
+        #[arg(long = "prompts", value_name = "DIR")]
+        prompts: Vec<PathBuf>,
+        /// Write the report JSON here (with several runs: FILE's stem plus the run's label).
+        #[arg(long)]
+        report: PathBuf,
+        /// Navigation: run a baseline instead of ivlmap (vlmap: nearest instance of each
+        /// category, as VLMaps; reference: each task's hand-written plan, no model).
+        #[arg(long, value_enum)]
+        baseline: Option<Baseline>,
+    },
+    /// Map tools: inspect, render, save.
+    Map {
+        #[command(subcommand)]
+        command: MapCommand,
+    },
+    /// Navigation under simulated perception noise: reference plans (ivlmap) and the
+    /// VLMaps baseline on maps built from corrupted perception, scored on the true scene.
+    NoiseStudy(crate::noise_cmd::NoiseStudyArgs),
+}
+
+#[derive(Debug, Subcommand)]
+pub(crate) enum MapCommand {
+    /// Print the instance table (id, label, k/n, colour, area, centroid) and regions.
+    Inspect {
+        /// Scene file or saved map folder.
+        map: PathBuf,
+    },
+    /// Draw the map (optionally with a trajectory) to a PNG.
+    Render {
+        /// Scene file or saved map folder.
+        map: PathBuf,
+        /// The PNG to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// A trajectory JSON (from `ivlmap run --trajectory`) to draw on top.
+        #[arg(long)]
+        trajectory: Option<PathBuf>,
+    },
+    /// Rasterise a scene and save the map folder (map.json, instances.json, .npy layers).
+    Save {
+        /// Scene file.
+        scene: PathBuf,
+        /// The folder to write.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Build a map folder from perception outputs (SAM masks + label map), an RGB-D
+    /// dataset or a VLMaps map, and print what was kept and dropped.
+    Build(Box<crate::mapbuild::MapBuildArgs>),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum Baseline {
+    /// VLMaps: the nearest instance of each mentioned category (no ordinals, no colours).
+    Vlmap,
+    /// The suite's hand-written reference plans (no model).
+    Reference,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct BackendArgs {
+    /// LLM backend: llama (local GGUF), openai (OpenAI-compatible server), replay (cassette).
+    #[arg(long, default_value = "llama")]
+    pub(crate) backend: String,
+    #[command(flatten)]
+    pub(crate) model_args: ModelArgs,
+}
+
+impl BackendArgs {
+    pub(crate) fn choice(&self) -> BackendChoice {
+        self.model_args.choice(&self.backend)
+    }
+}
+
+/// Backend settings shared by every command that talks to a model.
+#[derive(Debug, Args)]
+pub(crate) struct ModelArgs {
+    /// llama: GGUF file (default ~/.cache/ivlmap/models/qwen2.5-coder-1.5b-instruct-q4_k_m.gguf,
+    /// IVLMAP_MODELS overrides the folder); openai: model id.
+    #[arg(long)]
+    pub(crate) model: Option<String>,
+    /// openai: server base URL (else IVLMAP_BASE_URL; key from IVLMAP_API_KEY).
+    #[arg(long)]
+    pub(crate) base_url: Option<String>,
+    /// replay: the cassette to answer from.
+    #[arg(long)]
+    pub(crate) cassette: Option<PathBuf>,
+    /// Record every request and answer to this cassette.
+    #[arg(long)]
+    pub(crate) record: Option<PathBuf>,
+    /// llama: CPU threads.
+    #[arg(long)]
+    pub(crate) threads: Option<u32>,
+    /// Grammar-constrained decoding (llama; an openai server gets the grammar only if it
+    /// takes one): `tuples` holds step 1 to the tuple notation, `script` holds step 2 to
+    /// calls of the function library.
+    #[arg(long, value_enum, default_value_t = Grammar::Tuples)]
+    pub(crate) grammar: Grammar,
+    /// Use step 1's tuples as the model wrote them: no re-ask on missed words and no
+    /// reconciliation with the instruction's words (measures the model alone).
+    #[arg(long)]
+    pub(crate) raw_tuples: bool,
+}
+
+/// Which steps decode under a GBNF grammar.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum Grammar {
+    /// Neither.
+    None,
+    /// Step 1 (tuples).
+    Tuples,
+    /// Step 2 (scripts).
+    Script,
+    /// Both.
+    Both,
+}
+
+impl ModelArgs {
+    pub(crate) fn choice(&self, backend: &str) -> BackendChoice {
+        BackendChoice {
+            name: backend.to_string(),
+            model: self.model.clone(),
+            base_url: self.base_url.clone(),
+            cassette: self.cassette.clone(),
+            record: self.record.clone(),
+            threads: self.threads,
+        }
+    }
+
+    pub(crate) fn plan_options(&self) -> PlanOptions {
+        PlanOptions {
+            tuple_grammar: matches!(self.grammar, Grammar::Tuples | Grammar::Both),
+            script_grammar: matches!(self.grammar, Grammar::Script | Grammar::Both),
+            tuple_check: !self.raw_tuples,
+            reconcile: !self.raw_tuples,
+            ..PlanOptions::default()
+        }
+    }
+}
