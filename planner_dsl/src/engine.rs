@@ -174,7 +174,7 @@ fn register_library_fn(m: &mut Module, spec: &'static FunctionSpec, arity: usize
                 },
             );
         }
-        _ => {
+        4 => {
             reg(
                 m,
                 n,
@@ -190,8 +190,57 @@ fn register_library_fn(m: &mut Module, spec: &'static FunctionSpec, arity: usize
                 },
             );
         }
+        5 => {
+            reg(
+                m,
+                n,
+                move |c: Ctx<'_>, a: Dynamic, b: Dynamic, d: Dynamic, e: Dynamic, f: Dynamic| {
+                    dispatch(&c, spec, vec![a, b, d, e, f])
+                },
+            );
+            reg(
+                m,
+                n,
+                move |c: Ctx<'_>,
+                      _: H<'_>,
+                      a: Dynamic,
+                      b: Dynamic,
+                      d: Dynamic,
+                      e: Dynamic,
+                      f: Dynamic| { dispatch(&c, spec, vec![a, b, d, e, f]) },
+            );
+        }
+        _ => {
+            reg(
+                m,
+                n,
+                move |c: Ctx<'_>,
+                      a: Dynamic,
+                      b: Dynamic,
+                      d: Dynamic,
+                      e: Dynamic,
+                      f: Dynamic,
+                      g: Dynamic| { dispatch(&c, spec, vec![a, b, d, e, f, g]) },
+            );
+            reg(
+                m,
+                n,
+                move |c: Ctx<'_>,
+                      _: H<'_>,
+                      a: Dynamic,
+                      b: Dynamic,
+                      d: Dynamic,
+                      e: Dynamic,
+                      f: Dynamic,
+                      g: Dynamic| { dispatch(&c, spec, vec![a, b, d, e, f, g]) },
+            );
+        }
     }
 }
+
+/// The most arguments a library function may take ([`register_library_fn`] writes
+/// each arity out; a registry test checks every function fits).
+pub(crate) const MAX_LIBRARY_ARITY: usize = 6;
 
 /// The robot function library as a Rhai module (built once).
 fn library_module() -> SharedModule {
@@ -199,7 +248,7 @@ fn library_module() -> SharedModule {
     m.set_custom_type::<ObjectRecord>("Object");
     m.set_custom_type::<AgentHandle>("Agent");
     for spec in registry() {
-        for arity in spec.min_args()..=spec.max_args().min(4) {
+        for arity in spec.min_args()..=spec.max_args().min(MAX_LIBRARY_ARITY) {
             register_library_fn(&mut m, spec, arity);
         }
     }

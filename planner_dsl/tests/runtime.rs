@@ -180,3 +180,55 @@ fn plans_and_outcomes_cross_threads() {
     .unwrap();
     assert!((heading - 90.0).abs() < 1e-9);
 }
+
+/// An argument of `ty` that names something flat-a holds, so that most calls succeed
+/// (the second object of a call is another one).
+fn sample_arg((i, param): (usize, &planner_dsl::ParamSpec)) -> &'static str {
+    use planner_dsl::ParamType;
+    match param.ty {
+        ParamType::Object if i > 0 => "\"sofa\"",
+        ParamType::Object => "\"table\"",
+        ParamType::Name if param.name.contains("region") => "\"kitchen\"",
+        ParamType::Name => "\"table\"",
+        ParamType::Ordinal => "1",
+        ParamType::Colour => "\"\"",
+        ParamType::Order => "\"west_to_east\"",
+        ParamType::Position => "[2.0, 2.0]",
+        ParamType::Distance => "0.5",
+        ParamType::Angle => "30",
+        ParamType::Text => "\"hello\"",
+    }
+}
+
+/// Every signature the registry declares (each function at each arity, as `f(...)` and
+/// as `agent.f(...)`) is callable at run time: it runs, or the map refuses it with a
+/// map error; never "function not found" or an argument error for a declared arity.
+#[test]
+fn every_registered_signature_runs() {
+    let (map, _) = world("flat-a");
+    let mut checked = 0;
+    for spec in planner_dsl::registry() {
+        for arity in spec.min_args()..=spec.max_args() {
+            let args: Vec<&str> = spec.params[..arity]
+                .iter()
+                .enumerate()
+                .map(sample_arg)
+                .collect();
+            for prefix in ["", "agent."] {
+                let src = format!("{prefix}{}({});", spec.name, args.join(", "));
+                let plan = Plan::compile(&src).unwrap_or_else(|e| panic!("{src}: {e}"));
+                let mut robot = map_core::SimRobot::new(map.clone());
+                let out = run(&plan, &map, &mut robot, &Limits::default());
+                if let Some(e) = &out.error {
+                    assert_eq!(e.kind, RuntimeErrorKind::Map, "{src}: {e}");
+                }
+                checked += 1;
+            }
+        }
+    }
+    let expected: usize = planner_dsl::registry()
+        .iter()
+        .map(|f| 2 * (f.max_args() - f.min_args() + 1))
+        .sum();
+    assert_eq!(checked, expected);
+}
