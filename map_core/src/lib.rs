@@ -32,6 +32,7 @@ pub mod query;
 pub mod render;
 pub mod robot;
 pub mod scene;
+pub mod select;
 
 pub use crate::geometry::{Point, Polygon, Pose};
 pub use crate::grid::{Cell, Grid, GridFrame};

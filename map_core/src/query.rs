@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::geometry::Pose;
 use crate::map::{Instance, IvlMap, Region};
-use crate::matcher::{canonical, is_colour_word, plural, LexicalMatcher, NameMatcher};
+use crate::matcher::{plural, LexicalMatcher, NameMatcher};
+use crate::select::Selection;
 
 /// The order in which "the k-th" counts instances.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
@@ -30,11 +31,15 @@ pub enum ObjectOrder {
     WestToEast,
     /// Easternmost footprint centre first.
     EastToWest,
+    /// By footprint area, largest first ("the biggest table").
+    LargestToSmallest,
+    /// By footprint area, smallest first ("the smallest plant").
+    SmallestToLargest,
 }
 
 impl ObjectOrder {
     /// Every order with its name.
-    pub const ALL: [(ObjectOrder, &'static str); 8] = [
+    pub const ALL: [(ObjectOrder, &'static str); 10] = [
         (ObjectOrder::NearToFar, "near_to_far"),
         (ObjectOrder::FarToNear, "far_to_near"),
         (ObjectOrder::LeftToRight, "left_to_right"),
@@ -43,6 +48,8 @@ impl ObjectOrder {
         (ObjectOrder::SouthToNorth, "south_to_north"),
         (ObjectOrder::WestToEast, "west_to_east"),
         (ObjectOrder::EastToWest, "east_to_west"),
+        (ObjectOrder::LargestToSmallest, "largest_to_smallest"),
+        (ObjectOrder::SmallestToLargest, "smallest_to_largest"),
     ];
 
     /// Parse an order name; "", "default" and "nearest" mean [`ObjectOrder::NearToFar`].
@@ -61,6 +68,24 @@ impl ObjectOrder {
             })
     }
 
+    /// The same ranking counted from the other end ("the second to last from the
+    /// west" is the 2nd in `east_to_west`).
+    #[must_use]
+    pub fn reversed(self) -> ObjectOrder {
+        match self {
+            ObjectOrder::NearToFar => ObjectOrder::FarToNear,
+            ObjectOrder::FarToNear => ObjectOrder::NearToFar,
+            ObjectOrder::LeftToRight => ObjectOrder::RightToLeft,
+            ObjectOrder::RightToLeft => ObjectOrder::LeftToRight,
+            ObjectOrder::NorthToSouth => ObjectOrder::SouthToNorth,
+            ObjectOrder::SouthToNorth => ObjectOrder::NorthToSouth,
+            ObjectOrder::WestToEast => ObjectOrder::EastToWest,
+            ObjectOrder::EastToWest => ObjectOrder::WestToEast,
+            ObjectOrder::LargestToSmallest => ObjectOrder::SmallestToLargest,
+            ObjectOrder::SmallestToLargest => ObjectOrder::LargestToSmallest,
+        }
+    }
+
     /// The order's snake_case name, e.g. `near_to_far`.
     pub fn name(self) -> &'static str {
         ObjectOrder::ALL
@@ -70,7 +95,7 @@ impl ObjectOrder {
     }
 
     /// The sort key of an instance for this order (ascending = first).
-    fn key(self, inst: &Instance, robot: Pose) -> f64 {
+    pub(crate) fn key(self, inst: &Instance, robot: Pose) -> f64 {
         let c = inst.center();
         match self {
             ObjectOrder::NearToFar => inst.distance(robot.position),
@@ -81,6 +106,8 @@ impl ObjectOrder {
             ObjectOrder::SouthToNorth => c.y,
             ObjectOrder::WestToEast => c.x,
             ObjectOrder::EastToWest => -c.x,
+            ObjectOrder::LargestToSmallest => -inst.area_m2,
+            ObjectOrder::SmallestToLargest => inst.area_m2,
         }
     }
 }
@@ -156,7 +183,7 @@ pub enum QueryError {
         k: i64,
     },
     /// An order name that [`ObjectOrder::parse`] does not know.
-    #[error("unknown order {order:?}; use one of near_to_far, far_to_near, left_to_right, right_to_left, north_to_south, south_to_north, west_to_east, east_to_west")]
+    #[error("unknown order {order:?}; use one of {}", ObjectOrder::ALL.map(|(_, n)| n).join(", "))]
     UnknownOrder {
         /// The name as given.
         order: String,
@@ -184,6 +211,25 @@ pub enum QueryError {
         region: String,
         /// How many instances of the label the map holds outside the region.
         elsewhere: usize,
+    },
+    /// Every instance of the label has the excluded colour ("the table that isn't
+    /// yellow" where all tables are yellow).
+    #[error("every {name} here is {colour}")]
+    AllExcluded {
+        /// The matched label.
+        name: String,
+        /// The excluded colour.
+        colour: String,
+    },
+    /// "Between the two X" where not exactly two instances match.
+    #[error("\"the two {what}\" names {count} here, not 2 (ids {})", .ids.iter().map(u32::to_string).collect::<Vec<_>>().join(", "))]
+    NotExactlyTwo {
+        /// What was asked for ("yellow tables").
+        what: String,
+        /// How many match.
+        count: usize,
+        /// Their instance ids, in the selection's order.
+        ids: Vec<u32>,
     },
 }
 
@@ -278,103 +324,15 @@ impl IvlMap {
         order: ObjectOrder,
         robot: Pose,
     ) -> Result<&Instance, QueryError> {
-        if k < -1 {
-            return Err(QueryError::BadOrdinal { k });
-        }
-        let labels: Vec<&str> = {
-            let mut v: Vec<&str> = self.instances.iter().map(|i| i.label.as_str()).collect();
-            v.sort_unstable();
-            v.dedup();
-            v
+        let sel = Selection {
+            name: name.to_string(),
+            ordinal: k,
+            colour: colour.map(str::to_string),
+            order,
+            region: region.map(|r| r.name.clone()),
+            ..Selection::default()
         };
-        let label = matcher
-            .best(name, &labels)
-            .ok_or_else(|| QueryError::UnknownObject {
-                name: name.trim().to_string(),
-                known: self.label_counts(),
-            })?;
-        let mut same: Vec<&Instance> = self.instances.iter().filter(|i| i.label == label).collect();
-        if let Some(r) = region {
-            let all = same.len();
-            same.retain(|i| r.polygon.contains(i.centroid));
-            if same.is_empty() {
-                return Err(QueryError::NoneInRegion {
-                    name: label.to_string(),
-                    region: r.name.clone(),
-                    elsewhere: all,
-                });
-            }
-        }
-        let colour = colour.map(str::trim).filter(|c| !c.is_empty());
-        let mut cands: Vec<&Instance> = match colour {
-            None => same.clone(),
-            Some(c) => {
-                let want = canonical(c);
-                same.iter()
-                    .copied()
-                    .filter(|i| i.colour.as_deref().is_some_and(|ic| canonical(ic) == want))
-                    .collect()
-            }
-        };
-        if cands.is_empty() {
-            let c = colour.unwrap_or_default();
-            let map_colours: Vec<String> = self.colours.clone();
-            if !is_colour_word(c) && !map_colours.iter().any(|m| canonical(m) == canonical(c)) {
-                return Err(QueryError::NotAColour {
-                    name: label.to_string(),
-                    colour: c.to_string(),
-                    known: map_colours,
-                });
-            }
-            let mut available: Vec<(Option<String>, usize)> = Vec::new();
-            for i in &same {
-                match available.iter_mut().find(|(col, _)| *col == i.colour) {
-                    Some((_, n)) => *n += 1,
-                    None => available.push((i.colour.clone(), 1)),
-                }
-            }
-            available.sort_by(|a, b| (a.0.is_none(), &a.0).cmp(&(b.0.is_none(), &b.0)));
-            return Err(QueryError::NoSuchColour {
-                name: label.to_string(),
-                colour: c.to_string(),
-                available,
-            });
-        }
-        cands.sort_by(|a, b| {
-            order
-                .key(a, robot)
-                .total_cmp(&order.key(b, robot))
-                .then(a.id.cmp(&b.id))
-        });
-        let idx = match k {
-            -1 => cands.len() - 1,
-            0 => 0,
-            k => (k - 1) as usize,
-        };
-        cands.get(idx).copied().ok_or_else(|| {
-            let what = match colour {
-                Some(c) => format!(
-                    "{c} {}",
-                    if cands.len() == 1 {
-                        label.to_string()
-                    } else {
-                        plural(label)
-                    }
-                ),
-                None => {
-                    if cands.len() == 1 {
-                        label.to_string()
-                    } else {
-                        plural(label)
-                    }
-                }
-            };
-            QueryError::OrdinalPastCount {
-                what,
-                count: cands.len(),
-                k,
-            }
-        })
+        self.select_with(matcher, &sel, robot)
     }
 
     /// The region named `name` (case, synonyms and plural forgiven).

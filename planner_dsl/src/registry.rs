@@ -160,7 +160,7 @@ const REGION_ATTR_PARAMS: &[ParamSpec] = &[
     opt(
         "order",
         ParamType::Order,
-        "near_to_far (default), far_to_near, left_to_right, right_to_left, north_to_south, south_to_north, west_to_east, east_to_west",
+        "near_to_far (default), far_to_near, left_to_right, right_to_left, north_to_south, south_to_north, west_to_east, east_to_west, largest_to_smallest, smallest_to_largest",
     ),
 ];
 
@@ -191,7 +191,7 @@ const ATTR_PARAMS: &[ParamSpec] = &[
     opt(
         "order",
         ParamType::Order,
-        "near_to_far (default), far_to_near, left_to_right, right_to_left, north_to_south, south_to_north, west_to_east, east_to_west",
+        "near_to_far (default), far_to_near, left_to_right, right_to_left, north_to_south, south_to_north, west_to_east, east_to_west, largest_to_smallest, smallest_to_largest",
     ),
 ];
 

@@ -1,0 +1,528 @@
+//! Selections: everything a noun phrase says about which instance it means, as one
+//! value ("the second red chair next to the table in the kitchen"), and the one place
+//! that resolves it against the instance table.
+//!
+//! The semantics are design.md's "What people say, and what it means":
+//!
+//! | people say | selection |
+//! |---|---|
+//! | "the 3rd chair", "chair number 3", "table three" | `ordinal: 3` |
+//! | "the last chair", "the farthest chair", "the chair furthest from you" | `ordinal: -1` (near_to_far) |
+//! | "the second to last chair", "the penultimate chair" | `ordinal: 2`, the reversed order (`far_to_near`) |
+//! | "the red sofa", "the sofa, the red one", "a red sofa" | `colour: "red"` |
+//! | "the table that isn't yellow" | `not_colour: "yellow"` |
+//! | "the plant in the lounge" | `region: "lounge"` |
+//! | "the biggest table", "the smallest plant" | `ordinal: 1`, `largest_to_smallest` / `smallest_to_largest` |
+//! | "the chair next to / nearest / by the table" | `near: <the table's id>` (distances from its footprint) |
+//! | "between the two yellow tables" | [`IvlMap::select_pair`]: exactly two must match |
+//!
+//! Filters apply first (name, region, colour, excluded colour, the anchor itself
+//! left out), then the order ranks what is left and the ordinal picks.
+//!
+//! ```
+//! use map_core::select::Selection;
+//! use map_core::{IvlMap, Pose, Scene};
+//! let scene = Scene::from_json_str(
+//!     r#"{"format": "ivlmap-scene/1", "name": "t", "bounds": [0, 0, 10, 4],
+//!         "objects": [
+//!           {"id": 1, "category": "table", "colour": "yellow", "center": [2, 2], "size": [1, 1]},
+//!           {"id": 2, "category": "chair", "colour": "red", "center": [3.2, 2], "size": [0.5, 0.5]},
+//!           {"id": 3, "category": "chair", "colour": "red", "center": [8, 2], "size": [0.5, 0.5]},
+//!           {"id": 4, "category": "table", "colour": "black", "center": [9, 2], "size": [1.5, 1]}],
+//!         "robot": {"pose": [0.5, 0.5, 0], "radius": 0.2}}"#,
+//!     "t.scene.json",
+//! )
+//! .unwrap();
+//! let map = IvlMap::from_scene(&scene);
+//! let robot = map.start_pose;
+//! // "the chair next to the black table": chair 3, although chair 2 is nearer the robot
+//! let near = Selection::new("chair").near(4);
+//! assert_eq!(map.select(&near, robot).unwrap().id, 3);
+//! // "the table that isn't yellow"
+//! assert_eq!(map.select(&Selection::new("table").not_colour("yellow"), robot).unwrap().id, 4);
+//! // "the biggest table"
+//! let big = Selection::new("table").ordered("largest_to_smallest").unwrap();
+//! assert_eq!(map.select(&big, robot).unwrap().id, 4);
+//! ```
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::Pose;
+use crate::goals::closest_points;
+use crate::map::{Instance, IvlMap};
+use crate::matcher::{canonical, is_colour_word, plural, LexicalMatcher, NameMatcher};
+use crate::query::{ObjectOrder, QueryError};
+
+/// Which instance a noun phrase means: a category name, filters, an order and an
+/// ordinal. Built with [`Selection::new`] and the builder methods; resolved by
+/// [`IvlMap::select`].
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct Selection {
+    /// The category as said ("couch" finds the sofas through the matcher).
+    pub name: String,
+    /// k >= 1 the k-th in the order, -1 the last, 0 the first (unspecified).
+    #[serde(default)]
+    pub ordinal: i64,
+    /// Only instances of this colour.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<String>,
+    /// Only instances not of this colour ("the table that isn't yellow").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub not_colour: Option<String>,
+    /// The order the ordinal counts in.
+    #[serde(default)]
+    pub order: ObjectOrder,
+    /// Only instances whose footprint centroid lies in this region.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<String>,
+    /// An anchor instance id: distances (near_to_far, far_to_near) are measured from its
+    /// footprint instead of from the robot, and the anchor itself is left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub near: Option<u32>,
+}
+
+impl Selection {
+    /// Any instance called `name`; the first in the default order (the nearest).
+    #[must_use]
+    pub fn new(name: impl Into<String>) -> Self {
+        Selection {
+            name: name.into(),
+            ..Selection::default()
+        }
+    }
+
+    /// The k-th (k >= 1), the last (-1) or the first (0).
+    #[must_use]
+    pub fn nth(mut self, k: i64) -> Self {
+        self.ordinal = k;
+        self
+    }
+
+    /// Only instances of `colour`.
+    #[must_use]
+    pub fn colour(mut self, colour: impl Into<String>) -> Self {
+        self.colour = Some(colour.into());
+        self
+    }
+
+    /// Only instances not of `colour`.
+    #[must_use]
+    pub fn not_colour(mut self, colour: impl Into<String>) -> Self {
+        self.not_colour = Some(colour.into());
+        self
+    }
+
+    /// Counting in `order` (an order name, see [`ObjectOrder::parse`]).
+    ///
+    /// # Errors
+    /// [`QueryError::UnknownOrder`] for a name that is no order.
+    pub fn ordered(mut self, order: &str) -> Result<Self, QueryError> {
+        self.order = ObjectOrder::parse(order)?;
+        Ok(self)
+    }
+
+    /// Only instances in the region `region`.
+    #[must_use]
+    pub fn in_region(mut self, region: impl Into<String>) -> Self {
+        self.region = Some(region.into());
+        self
+    }
+
+    /// Ranked by distance from the footprint of instance `anchor`.
+    #[must_use]
+    pub fn near(mut self, anchor: u32) -> Self {
+        self.near = Some(anchor);
+        self
+    }
+}
+
+/// The distance between two footprints (0 when they touch).
+fn footprint_distance(a: &Instance, b: &Instance) -> f64 {
+    closest_points(&a.contour, &b.contour).map_or(f64::INFINITY, |(p, q)| p.dist(q))
+}
+
+/// Trimmed, and `None` when empty.
+fn given(s: Option<&str>) -> Option<&str> {
+    s.map(str::trim).filter(|c| !c.is_empty())
+}
+
+impl IvlMap {
+    /// The instance `sel` means, with the built-in lexical matcher.
+    ///
+    /// # Errors
+    /// A [`QueryError`] that says what the map holds: no such name, region or colour,
+    /// every candidate excluded, an ordinal past the count, an unknown anchor.
+    pub fn select(&self, sel: &Selection, robot: Pose) -> Result<&Instance, QueryError> {
+        self.select_with(&LexicalMatcher, sel, robot)
+    }
+
+    /// [`IvlMap::select`] with a chosen [`NameMatcher`].
+    ///
+    /// # Errors
+    /// As [`IvlMap::select`].
+    pub fn select_with(
+        &self,
+        matcher: &dyn NameMatcher,
+        sel: &Selection,
+        robot: Pose,
+    ) -> Result<&Instance, QueryError> {
+        let k = sel.ordinal;
+        if k < -1 {
+            return Err(QueryError::BadOrdinal { k });
+        }
+        let (label, cands) = self.candidates_with(matcher, sel, robot)?;
+        let idx = match k {
+            -1 => cands.len() - 1,
+            0 => 0,
+            k => usize::try_from(k - 1).unwrap_or(usize::MAX),
+        };
+        cands.get(idx).copied().ok_or_else(|| {
+            let noun = if cands.len() == 1 {
+                label.clone()
+            } else {
+                plural(&label)
+            };
+            let what = match given(sel.colour.as_deref()) {
+                Some(c) => format!("{c} {noun}"),
+                None => noun,
+            };
+            QueryError::OrdinalPastCount {
+                what,
+                count: cands.len(),
+                k,
+            }
+        })
+    }
+
+    /// "Between the two yellow tables": the two instances `sel`'s filters leave, in
+    /// its order; an error naming how many match when that is not exactly two.
+    ///
+    /// # Errors
+    /// [`QueryError::NotExactlyTwo`] with the count, or the errors of
+    /// [`IvlMap::select`] when nothing matches at all.
+    pub fn select_pair(&self, sel: &Selection, robot: Pose) -> Result<[&Instance; 2], QueryError> {
+        let (label, cands) = self.candidates_with(&LexicalMatcher, sel, robot)?;
+        match cands[..] {
+            [a, b] => Ok([a, b]),
+            _ => Err(QueryError::NotExactlyTwo {
+                what: match given(sel.colour.as_deref()) {
+                    Some(c) => format!("{c} {}", plural(&label)),
+                    None => plural(&label),
+                },
+                count: cands.len(),
+                ids: cands.iter().map(|i| i.id).collect(),
+            }),
+        }
+    }
+
+    /// The instances `sel`'s filters leave (never empty), ranked in its order, with
+    /// the matched label.
+    ///
+    /// # Errors
+    /// As [`IvlMap::select`], but for the ordinal.
+    pub fn candidates_with(
+        &self,
+        matcher: &dyn NameMatcher,
+        sel: &Selection,
+        robot: Pose,
+    ) -> Result<(String, Vec<&Instance>), QueryError> {
+        let labels: Vec<&str> = {
+            let mut v: Vec<&str> = self.instances.iter().map(|i| i.label.as_str()).collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        };
+        let label = matcher
+            .best(&sel.name, &labels)
+            .ok_or_else(|| QueryError::UnknownObject {
+                name: sel.name.trim().to_string(),
+                known: self.label_counts(),
+            })?
+            .to_string();
+        let anchor = match sel.near {
+            Some(id) => Some(
+                self.instance_by_id(id)
+                    .ok_or(QueryError::UnknownInstance { id })?,
+            ),
+            None => None,
+        };
+        let mut same: Vec<&Instance> = self
+            .instances
+            .iter()
+            .filter(|i| i.label == label && Some(i.id) != sel.near)
+            .collect();
+        if let Some(name) = given(sel.region.as_deref()) {
+            let r = self.find_region_with(matcher, name)?;
+            let all = same.len();
+            same.retain(|i| r.polygon.contains(i.centroid));
+            if same.is_empty() {
+                return Err(QueryError::NoneInRegion {
+                    name: label,
+                    region: r.name.clone(),
+                    elsewhere: all,
+                });
+            }
+        }
+        for c in [
+            given(sel.colour.as_deref()),
+            given(sel.not_colour.as_deref()),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            if !is_colour_word(c) && !self.colours.iter().any(|m| canonical(m) == canonical(c)) {
+                return Err(QueryError::NotAColour {
+                    name: label,
+                    colour: c.to_string(),
+                    known: self.colours.clone(),
+                });
+            }
+        }
+        let is = |i: &Instance, c: &str| {
+            i.colour
+                .as_deref()
+                .is_some_and(|ic| canonical(ic) == canonical(c))
+        };
+        let mut cands: Vec<&Instance> = same
+            .iter()
+            .copied()
+            .filter(|i| given(sel.colour.as_deref()).is_none_or(|c| is(i, c)))
+            .filter(|i| given(sel.not_colour.as_deref()).is_none_or(|c| !is(i, c)))
+            .collect();
+        if cands.is_empty() {
+            if let Some(c) = given(sel.not_colour.as_deref()) {
+                if given(sel.colour.as_deref()).is_none() {
+                    return Err(QueryError::AllExcluded {
+                        name: label,
+                        colour: c.to_string(),
+                    });
+                }
+            }
+            let mut available: Vec<(Option<String>, usize)> = Vec::new();
+            for i in &same {
+                match available.iter_mut().find(|(col, _)| *col == i.colour) {
+                    Some((_, n)) => *n += 1,
+                    None => available.push((i.colour.clone(), 1)),
+                }
+            }
+            available.sort_by(|a, b| (a.0.is_none(), &a.0).cmp(&(b.0.is_none(), &b.0)));
+            return Err(QueryError::NoSuchColour {
+                name: label,
+                colour: given(sel.colour.as_deref()).unwrap_or_default().to_string(),
+                available,
+            });
+        }
+        let key = |i: &Instance| match (anchor, sel.order) {
+            (Some(a), ObjectOrder::NearToFar) => footprint_distance(a, i),
+            (Some(a), ObjectOrder::FarToNear) => -footprint_distance(a, i),
+            _ => sel.order.key(i, robot),
+        };
+        cands.sort_by(|a, b| key(a).total_cmp(&key(b)).then(a.id.cmp(&b.id)));
+        Ok((label, cands))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Point;
+    use crate::scene::Scene;
+
+    /// Robot at the origin facing north. Four tables along y = 3 (yellow 1 x 1 at
+    /// x = 1, black at 2.5, yellow at 4, grey 2 x 1 at 7), a red chair beside each of
+    /// tables 1 and 4 (north of them), a blue one beside table 3, a kitchen around the
+    /// east half.
+    fn map() -> IvlMap {
+        let s = Scene::from_json_str(
+            r#"{"format": "ivlmap-scene/1", "name": "s", "bounds": [-1, -1, 10, 7], "cell_size": 0.05,
+            "regions": [{"name": "kitchen", "polygon": [[5,-1],[10,-1],[10,7],[5,7]]}],
+            "objects": [
+              {"id": 1, "category": "table", "colour": "yellow", "center": [1.0, 3.0], "size": [1.0, 1.0]},
+              {"id": 2, "category": "table", "colour": "black", "center": [2.5, 3.0], "size": [0.8, 0.8]},
+              {"id": 3, "category": "table", "colour": "yellow", "center": [4.0, 3.0], "size": [0.8, 0.8]},
+              {"id": 4, "category": "table", "colour": "grey", "center": [7.0, 3.0], "size": [2.0, 1.0]},
+              {"id": 11, "category": "chair", "colour": "red", "center": [1.0, 4.2], "size": [0.5, 0.5]},
+              {"id": 13, "category": "chair", "colour": "blue", "center": [4.0, 4.1], "size": [0.5, 0.5]},
+              {"id": 14, "category": "chair", "colour": "red", "center": [7.0, 4.3], "size": [0.5, 0.5]}
+            ],
+            "robot": {"pose": [0, 0, 0], "radius": 0.2}}"#,
+            "s.scene.json",
+        )
+        .unwrap();
+        IvlMap::from_scene(&s)
+    }
+
+    const ORIGIN: Pose = Pose {
+        position: Point::new(0.0, 0.0),
+        heading: 0.0,
+    };
+
+    fn pick(m: &IvlMap, s: &Selection) -> u32 {
+        m.select(s, ORIGIN).unwrap().id
+    }
+
+    #[test]
+    fn the_farthest_is_the_last_nearest_first() {
+        let m = map();
+        assert_eq!(pick(&m, &Selection::new("table").nth(-1)), 4);
+        assert_eq!(pick(&m, &Selection::new("table")), 1);
+    }
+
+    #[test]
+    fn second_to_last_counts_the_reversed_order() {
+        let m = map();
+        // penultimate by distance: the 2nd farthest
+        let far = Selection::new("table")
+            .ordered("far_to_near")
+            .unwrap()
+            .nth(2);
+        assert_eq!(pick(&m, &far), 3);
+        // second to last from the west = 2nd from the east
+        let west = Selection::new("table").ordered("west_to_east").unwrap();
+        let mut east = west.clone().nth(2);
+        east.order = west.order.reversed();
+        assert_eq!(pick(&m, &east), 3);
+        assert_eq!(ObjectOrder::EastToWest.reversed(), ObjectOrder::WestToEast);
+        for (o, _) in ObjectOrder::ALL {
+            assert_eq!(o.reversed().reversed(), o);
+            assert_ne!(o.reversed(), o);
+        }
+    }
+
+    #[test]
+    fn a_number_is_the_kth_and_past_the_count_says_how_many() {
+        let m = map();
+        assert_eq!(pick(&m, &Selection::new("chair").nth(3)), 14);
+        let e = m
+            .select(&Selection::new("chair").nth(4), ORIGIN)
+            .unwrap_err();
+        assert_eq!(e.to_string(), "there are 3 chairs; asked for the 4th");
+    }
+
+    #[test]
+    fn next_to_ranks_by_footprint_distance_from_the_anchor() {
+        let m = map();
+        // "the chair next to the grey table": chair 14, though 11 is nearer the robot
+        assert_eq!(pick(&m, &Selection::new("chair").near(4)), 14);
+        // "the second chair closest to table 3": chair 13 first, then whichever of 11
+        // and 14 has the nearer footprint
+        let d = |a: u32, b: u32| {
+            let (a, b) = (m.instance_by_id(a).unwrap(), m.instance_by_id(b).unwrap());
+            footprint_distance(a, b)
+        };
+        let second = if d(3, 11) < d(3, 14) { 11 } else { 14 };
+        assert_eq!(pick(&m, &Selection::new("chair").near(3)), 13);
+        assert_eq!(pick(&m, &Selection::new("chair").near(3).nth(2)), second);
+        // the colour filter first: the red chair next to table 3
+        assert_eq!(
+            pick(&m, &Selection::new("chair").colour("red").near(3)),
+            second
+        );
+        // the anchor itself is never the answer: "the table next to table 2"
+        let t = pick(&m, &Selection::new("table").near(2));
+        assert!(t == 1 || t == 3, "{t}");
+        assert!(matches!(
+            m.select(&Selection::new("chair").near(99), ORIGIN),
+            Err(QueryError::UnknownInstance { id: 99 })
+        ));
+    }
+
+    #[test]
+    fn in_a_region_only_counts_what_is_inside() {
+        let m = map();
+        assert_eq!(pick(&m, &Selection::new("table").in_region("kitchen")), 4);
+        assert_eq!(pick(&m, &Selection::new("chair").in_region("Kitchen")), 14);
+        let e = m
+            .select(
+                &Selection::new("table")
+                    .colour("yellow")
+                    .in_region("kitchen"),
+                ORIGIN,
+            )
+            .unwrap_err();
+        assert!(matches!(e, QueryError::NoSuchColour { .. }), "{e}");
+    }
+
+    #[test]
+    fn an_excluded_colour_leaves_the_others() {
+        let m = map();
+        // "the table that isn't yellow": the nearest of black and grey
+        assert_eq!(pick(&m, &Selection::new("table").not_colour("yellow")), 2);
+        assert_eq!(
+            pick(&m, &Selection::new("chair").not_colour("red")),
+            13,
+            "the only chair that is not red"
+        );
+        let e = m
+            .select(
+                &Selection::new("chair").colour("blue").not_colour("blue"),
+                ORIGIN,
+            )
+            .unwrap_err();
+        assert!(matches!(e, QueryError::NoSuchColour { .. }), "{e}");
+        let yellow_only = Selection::new("table").colour("yellow").not_colour("black");
+        assert_eq!(pick(&m, &yellow_only), 1);
+        // the only table in the kitchen is grey: excluding grey leaves none
+        let e = m
+            .select(
+                &Selection::new("table")
+                    .in_region("kitchen")
+                    .not_colour("grey"),
+                ORIGIN,
+            )
+            .unwrap_err();
+        assert_eq!(e.to_string(), "every table here is grey");
+        let e = m
+            .select(&Selection::new("table").not_colour("left"), ORIGIN)
+            .unwrap_err();
+        assert!(matches!(e, QueryError::NotAColour { .. }), "{e}");
+    }
+
+    #[test]
+    fn biggest_and_smallest_rank_by_footprint_area() {
+        let m = map();
+        let big = Selection::new("table")
+            .ordered("largest_to_smallest")
+            .unwrap();
+        assert_eq!(pick(&m, &big), 4);
+        assert_eq!(pick(&m, &big.clone().nth(2)), 1);
+        let small = Selection::new("table")
+            .ordered("smallest_to_largest")
+            .unwrap();
+        // tables 2 and 3 are the same size: the lower id first
+        assert_eq!(pick(&m, &small), 2);
+        assert_eq!(
+            ObjectOrder::parse("largest to smallest").unwrap(),
+            ObjectOrder::LargestToSmallest
+        );
+    }
+
+    #[test]
+    fn the_two_x_must_be_exactly_two() {
+        let m = map();
+        let [a, b] = m
+            .select_pair(&Selection::new("table").colour("yellow"), ORIGIN)
+            .unwrap();
+        assert_eq!((a.id, b.id), (1, 3));
+        let e = m.select_pair(&Selection::new("table"), ORIGIN).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "\"the two tables\" names 4 here, not 2 (ids 1, 2, 3, 4)"
+        );
+        let e = m
+            .select_pair(&Selection::new("chair").colour("blue"), ORIGIN)
+            .unwrap_err();
+        assert!(
+            matches!(e, QueryError::NotExactlyTwo { count: 1, .. }),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn selections_read_and_write_json_with_defaults() {
+        let s: Selection = serde_json::from_str(r#"{"name": "chair", "near": 4}"#).unwrap();
+        assert_eq!(s, Selection::new("chair").near(4));
+        let back: Selection = serde_json::from_str(&serde_json::to_string(&s).unwrap()).unwrap();
+        assert_eq!(back, s);
+    }
+}
