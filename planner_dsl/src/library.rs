@@ -10,6 +10,7 @@ use map_core::goals::{
     approach_point, between_point, face_heading, heading_with_object_on, lateral_point,
     region_point, side_point, Side,
 };
+use map_core::select::Selection;
 use map_core::{
     Instance, IvlMap, ObjectOrder, Point, QueryError, Region, Robot, RobotError, StopTarget,
 };
@@ -250,6 +251,15 @@ impl<'a> Host<'a> {
                     .map_err(map_err)?;
                 value(Dynamic::from(record(inst)))
             }
+            "get_obj" => {
+                let obj_name = self.name_arg(spec, 0, &args[0])?;
+                let sel = match args.get(1) {
+                    Some(a) => self.selection_arg(spec, 1, a, obj_name)?,
+                    None => Selection::new(obj_name),
+                };
+                let inst = self.map.select(&sel, pose).map_err(map_err)?;
+                value(Dynamic::from(record(inst)))
+            }
             "move_to" => {
                 let goal = self.position_arg(spec, 0, &args[0])?;
                 let rep = self
@@ -487,6 +497,61 @@ impl<'a> Host<'a> {
             ));
         }
         Ok(x)
+    }
+
+    /// A selection map: `#{ordinal, colour, not_colour, order, region, near}`.
+    fn selection_arg(
+        &self,
+        spec: &FunctionSpec,
+        idx: usize,
+        a: &Dynamic,
+        name: String,
+    ) -> Result<Selection, CallError> {
+        const KEYS: &str = "ordinal, colour, not_colour, order, region, near";
+        let mut sel = Selection::new(name);
+        if a.is_unit() {
+            return Ok(sel);
+        }
+        let Some(m) = a.read_lock::<rhai::Map>() else {
+            return Err(arg_err(
+                spec,
+                idx,
+                format!(
+                    "must be a map such as #{{ordinal: 2, colour: \"red\"}}, got {}",
+                    type_word(a)
+                ),
+            ));
+        };
+        for (key, v) in m.iter() {
+            match key.as_str() {
+                "ordinal" => sel.ordinal = self.ordinal_arg(spec, idx, v)?,
+                "colour" | "color" => sel.colour = self.colour_arg(spec, idx, v)?,
+                "not_colour" | "not_color" => sel.not_colour = self.colour_arg(spec, idx, v)?,
+                "order" => sel.order = self.order_arg(spec, idx, v)?,
+                "region" => sel.region = Some(self.name_arg(spec, idx, v)?),
+                "near" => match self.target(spec, idx, v)? {
+                    Target::Instance(i) => sel.near = Some(i.id),
+                    Target::Region(r) => {
+                        return Err(arg_err(
+                            spec,
+                            idx,
+                            format!(
+                                "key `near` must be an object, got the region {:?} (use `region`)",
+                                r.name
+                            ),
+                        ))
+                    }
+                },
+                other => {
+                    return Err(arg_err(
+                        spec,
+                        idx,
+                        format!("has an unknown key `{other}`; the keys are {KEYS}"),
+                    ))
+                }
+            }
+        }
+        Ok(sel)
     }
 
     fn ordinal_arg(&self, spec: &FunctionSpec, idx: usize, a: &Dynamic) -> Result<i64, CallError> {

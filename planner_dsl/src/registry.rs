@@ -31,6 +31,10 @@ pub enum ParamType {
     Angle,
     /// Free text.
     Text,
+    /// What else the person said about the object, as a map with any of the keys
+    /// `ordinal`, `colour`, `not_colour`, `order`, `region` and `near` (another object):
+    /// `#{ordinal: 2, near: table}`.
+    Selection,
 }
 
 impl ParamType {
@@ -46,6 +50,9 @@ impl ParamType {
             ParamType::Distance => "number (metres)",
             ParamType::Angle => "number (degrees)",
             ParamType::Text => "string",
+            ParamType::Selection => {
+                "map #{ordinal, colour, not_colour, order, region, near}, every key optional"
+            }
         }
     }
 }
@@ -230,6 +237,15 @@ const DIST: &[ParamSpec] = &[req(
 
 const TEXT: &[ParamSpec] = &[req("text", ParamType::Text, "what to tell the user")];
 
+const SELECT_PARAMS: &[ParamSpec] = &[
+    req("object_name", ParamType::Name, "category name, e.g. \"chair\""),
+    opt(
+        "select",
+        ParamType::Selection,
+        "ordinal: k-th (1 = first, -1 = last); colour; not_colour: a colour it must not have; order: what the ordinal counts in (default near_to_far; largest_to_smallest for \"the biggest\"); region: a room it is in; near: an object it is next to (distances then count from that object)",
+    ),
+];
+
 const fn f(
     name: &'static str,
     params: &'static [ParamSpec],
@@ -271,6 +287,14 @@ static REGISTRY: &[FunctionSpec] = &[
         "object record (fields: name, colour, label_id, id, position)",
         "pick one object in a room (\"the plant in the lounge\"), like get_obj_attributes counting only the objects in that region",
         "let plant = agent.get_obj_in_region(\"plant\", \"lounge\");",
+        false,
+    ),
+    f(
+        "get_obj",
+        SELECT_PARAMS,
+        "object record (fields: name, colour, label_id, id, position)",
+        "pick one object by everything said about it (\"the second chair next to the red table\", \"the sofa that isn't grey\", \"the biggest plant in the lounge\")",
+        "let chair = agent.get_obj(\"chair\", #{ordinal: 2, near: agent.get_obj(\"table\", #{colour: \"red\"})});",
         false,
     ),
     f(
@@ -614,7 +638,7 @@ mod tests {
         ] {
             assert!(lookup(name).is_some(), "{name} missing");
         }
-        assert_eq!(registry().len(), 23);
+        assert_eq!(registry().len(), 24); // the paper's 21 (two spellings) + say, get_obj_in_region, get_obj
     }
 
     #[test]

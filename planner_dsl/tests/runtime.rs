@@ -197,6 +197,7 @@ fn sample_arg((i, param): (usize, &planner_dsl::ParamSpec)) -> &'static str {
         ParamType::Distance => "0.5",
         ParamType::Angle => "30",
         ParamType::Text => "\"hello\"",
+        ParamType::Selection => "#{ordinal: 1, near: \"sofa\"}",
     }
 }
 
@@ -231,4 +232,51 @@ fn every_registered_signature_runs() {
         .map(|f| 2 * (f.max_args() - f.min_args() + 1))
         .sum();
     assert_eq!(checked, expected);
+}
+
+/// `get_obj` resolves a selection map through `map_core::select` (the semantics are
+/// unit-tested there); here: the map reaches it, and bad maps are argument errors that
+/// name the key.
+#[test]
+fn get_obj_takes_a_selection_map() {
+    let (map, _) = world("flat-a");
+    let id_of = |src: &str| {
+        let plan = Plan::compile(&format!("let o = {src};\nsay(`${{o.id}}`);")).unwrap();
+        let mut robot = map_core::SimRobot::new(map.clone());
+        let out = run(&plan, &map, &mut robot, &Limits::default());
+        match out.error {
+            None => Ok(out.said.join("")),
+            Some(e) => Err(e),
+        }
+    };
+    // "the biggest table": the 2.0 x 0.9 yellow one
+    assert_eq!(
+        id_of("get_obj(\"table\", #{order: \"largest_to_smallest\"})").unwrap(),
+        "8"
+    );
+    assert_eq!(
+        id_of("get_obj(\"table\", #{not_colour: \"yellow\", ordinal: 1, order: \"west_to_east\"})")
+            .unwrap(),
+        "19",
+        "the westernmost table that isn't yellow: the white one at x = 2.65 (black 3 is at 2.7)"
+    );
+    // the table next to the black sofa (id 2) is the black table (id 3)
+    assert_eq!(
+        id_of("agent.get_obj(\"table\", #{near: get_obj(\"sofa\", #{colour: \"black\"})})")
+            .unwrap(),
+        "3"
+    );
+    assert_eq!(
+        id_of("get_obj(\"table\")").unwrap(),
+        id_of("get_obj_attributes(\"table\")").unwrap()
+    );
+    let e = id_of("get_obj(\"table\", #{colour: \"yellow\", nearest: true})").unwrap_err();
+    assert_eq!(e.kind, RuntimeErrorKind::Argument);
+    assert!(e.message.contains("unknown key `nearest`"), "{e}");
+    let e = id_of("get_obj(\"table\", 3)").unwrap_err();
+    assert!(e.message.contains("must be a map"), "{e}");
+    let e = id_of("get_obj(\"table\", #{near: \"kitchen\"})").unwrap_err();
+    assert!(e.message.contains("use `region`"), "{e}");
+    let e = id_of("get_obj(\"table\", #{not_colour: \"yellow\", colour: \"yellow\"})").unwrap_err();
+    assert_eq!(e.kind, RuntimeErrorKind::Map);
 }
