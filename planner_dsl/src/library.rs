@@ -105,6 +105,8 @@ pub(crate) struct Host<'a> {
     map: &'a IvlMap,
     robot: &'a mut dyn Robot,
     max_calls: usize,
+    /// Where the robot was when the plan began (`move_to_start`).
+    start: Point,
     pub(crate) trace: Vec<TraceEntry>,
     pub(crate) said: Vec<String>,
     pub(crate) failure: Option<RuntimeError>,
@@ -126,6 +128,7 @@ impl<'a> Host<'a> {
     pub(crate) fn new(map: &'a IvlMap, robot: &'a mut dyn Robot, limits: &Limits) -> Self {
         Host {
             map,
+            start: robot.pose().position,
             robot,
             max_calls: limits.max_library_calls,
             trace: Vec::new(),
@@ -297,6 +300,19 @@ impl<'a> Host<'a> {
                     ));
                 }
                 self.go(between_point(a, b), name, StopTarget::Between([a.id, b.id]))
+            }
+            "move_between_the_two" => {
+                let obj_name = self.name_arg(spec, 0, &args[0])?;
+                let sel = match args.get(1) {
+                    Some(a) => self.selection_arg(spec, 1, a, obj_name)?,
+                    None => Selection::new(obj_name),
+                };
+                let [a, b] = self.map.select_pair(&sel, pose).map_err(map_err)?;
+                self.go(between_point(a, b), name, StopTarget::Between([a.id, b.id]))
+            }
+            "move_to_start" => {
+                let p = self.start;
+                self.go(p, name, StopTarget::Point([p.x, p.y]))
             }
             "move_to_object" => match self.target(spec, 0, &args[0])? {
                 Target::Instance(inst) => self.go(

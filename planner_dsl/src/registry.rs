@@ -450,6 +450,22 @@ static REGISTRY: &[FunctionSpec] = &[
         true,
     ),
     f(
+        "move_between_the_two",
+        SELECT_PARAMS,
+        "()",
+        "move midway between the two objects that match (\"between the two yellow tables\"); an error says how many match when that is not two",
+        "agent.move_between_the_two(\"table\", #{colour: \"yellow\"});",
+        true,
+    ),
+    f(
+        "move_to_start",
+        &[],
+        "()",
+        "move back to where the robot was when this plan began (\"come back here\", \"back to where you started\")",
+        "agent.move_to_start();",
+        true,
+    ),
+    f(
         "say",
         TEXT,
         "()",
@@ -638,7 +654,7 @@ mod tests {
         ] {
             assert!(lookup(name).is_some(), "{name} missing");
         }
-        assert_eq!(registry().len(), 24); // the paper's 21 (two spellings) + say, get_obj_in_region, get_obj
+        assert_eq!(registry().len(), 26); // the paper's 21 (two spellings) + say, get_obj_in_region, get_obj, move_between_the_two, move_to_start
     }
 
     #[test]

@@ -280,3 +280,32 @@ fn get_obj_takes_a_selection_map() {
     let e = id_of("get_obj(\"table\", #{not_colour: \"yellow\", colour: \"yellow\"})").unwrap_err();
     assert_eq!(e.kind, RuntimeErrorKind::Map);
 }
+
+/// "Between the two yellow tables" needs exactly two; "come back here" returns to where
+/// the plan began.
+#[test]
+fn between_the_two_and_back_to_the_start() {
+    let (map, _) = world("flat-a");
+    let go = |src: &str| {
+        let plan = Plan::compile(src).unwrap();
+        let mut robot = map_core::SimRobot::new(map.clone());
+        let out = run(&plan, &map, &mut robot, &Limits::default());
+        (out, robot)
+    };
+    let (out, robot) = go("move_between_the_two(\"table\", #{colour: \"yellow\"});");
+    assert!(out.error.is_none(), "{:?}", out.error);
+    let stop = &robot.trajectory().stops[0];
+    assert_eq!(stop.target, map_core::StopTarget::Between([8, 17]));
+    let (out, _) = go("move_between_the_two(\"table\");");
+    let e = out.error.unwrap();
+    assert_eq!(e.kind, RuntimeErrorKind::Map);
+    assert!(e.message.contains("not 2"), "{e}");
+    let start = map.start_pose.position;
+    let (out, robot) = go("agent.move_to_object(\"fridge\");\nagent.move_to_start();");
+    assert!(out.error.is_none(), "{:?}", out.error);
+    let back = robot.trajectory().stops[1].pose;
+    assert!(
+        (back[0] - start.x).hypot(back[1] - start.y) < 0.1,
+        "{back:?} vs {start:?}"
+    );
+}
