@@ -255,11 +255,7 @@ impl<'a> Host<'a> {
                 value(Dynamic::from(record(inst)))
             }
             "get_obj" => {
-                let obj_name = self.name_arg(spec, 0, &args[0])?;
-                let sel = match args.get(1) {
-                    Some(a) => self.selection_arg(spec, 1, a, obj_name)?,
-                    None => Selection::new(obj_name),
-                };
+                let sel = self.selection_args(spec, args)?;
                 let inst = self.map.select(&sel, pose).map_err(map_err)?;
                 value(Dynamic::from(record(inst)))
             }
@@ -302,11 +298,7 @@ impl<'a> Host<'a> {
                 self.go(between_point(a, b), name, StopTarget::Between([a.id, b.id]))
             }
             "move_between_the_two" => {
-                let obj_name = self.name_arg(spec, 0, &args[0])?;
-                let sel = match args.get(1) {
-                    Some(a) => self.selection_arg(spec, 1, a, obj_name)?,
-                    None => Selection::new(obj_name),
-                };
+                let sel = self.selection_args(spec, args)?;
                 let [a, b] = self.map.select_pair(&sel, pose).map_err(map_err)?;
                 self.go(between_point(a, b), name, StopTarget::Between([a.id, b.id]))
             }
@@ -513,6 +505,19 @@ impl<'a> Host<'a> {
             ));
         }
         Ok(x)
+    }
+
+    /// `(object_name, [select])`: the name and the optional selection map.
+    fn selection_args(
+        &self,
+        spec: &FunctionSpec,
+        args: &[Dynamic],
+    ) -> Result<Selection, CallError> {
+        let name = self.name_arg(spec, 0, &args[0])?;
+        match args.get(1) {
+            Some(a) => self.selection_arg(spec, 1, a, name),
+            None => Ok(Selection::new(name)),
+        }
     }
 
     /// A selection map: `#{ordinal, colour, not_colour, order, region, near}`.
