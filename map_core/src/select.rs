@@ -251,6 +251,14 @@ impl IvlMap {
             .iter()
             .filter(|i| i.label == label && Some(i.id) != sel.near)
             .collect();
+        if same.is_empty() {
+            // the anchor was the only one: "the table next to the table" with one table
+            return Err(QueryError::OrdinalPastCount {
+                what: format!("other {}", plural(&label)),
+                count: 0,
+                k: sel.ordinal.max(1),
+            });
+        }
         if let Some(name) = given(sel.region.as_deref()) {
             let r = self.find_region_with(matcher, name)?;
             let all = same.len();
@@ -352,6 +360,17 @@ mod tests {
         IvlMap::from_scene(&s)
     }
 
+    fn map_with_one_table() -> IvlMap {
+        let s = Scene::from_json_str(
+            r#"{"format": "ivlmap-scene/1", "name": "one", "bounds": [0, 0, 4, 4],
+            "objects": [{"id": 1, "category": "table", "colour": "red", "center": [2, 2], "size": [1, 1]}],
+            "robot": {"pose": [0.5, 0.5, 0], "radius": 0.2}}"#,
+            "one.scene.json",
+        )
+        .unwrap();
+        IvlMap::from_scene(&s)
+    }
+
     const ORIGIN: Pose = Pose {
         position: Point::new(0.0, 0.0),
         heading: 0.0,
@@ -425,6 +444,12 @@ mod tests {
             m.select(&Selection::new("chair").near(99), ORIGIN),
             Err(QueryError::UnknownInstance { id: 99 })
         ));
+        // "the table next to the table" where there is one table: an error, not a panic
+        let lone = map_with_one_table();
+        let e = lone
+            .select(&Selection::new("table").near(1), ORIGIN)
+            .unwrap_err();
+        assert_eq!(e.to_string(), "there are 0 other tables; asked for the 1st");
     }
 
     #[test]
