@@ -1,4 +1,5 @@
-//! Fuzz target: compile + validate + dry run of arbitrary text as a plan, on the
+//! Fuzz target: the typed plan's parse/print round trip, and compile + validate + dry
+//! run of arbitrary text as a plan, on the
 //! flat-a example scene. Any panic, any run past libFuzzer's -timeout, or memory past
 //! -rss_limit_mb is a finding.
 #![no_main]
@@ -30,6 +31,15 @@ fuzz_target!(|data: &[u8]| {
         deadline: Duration::from_millis(300),
         ..Limits::default()
     };
+    // The typed plan never panics, and what it reads prints back to the same plan.
+    if let Ok(typed) = planner_dsl::typed::TypedPlan::parse(source) {
+        let printed = typed.to_rhai();
+        assert_eq!(
+            planner_dsl::typed::TypedPlan::parse(&printed).as_ref(),
+            Ok(&typed),
+            "{printed}"
+        );
+    }
     match Plan::compile_with(source, &limits) {
         Err(PlanError::Syntax { message, .. }) => assert!(!message.is_empty()),
         Err(PlanError::TooLong { bytes, limit }) => assert!(bytes > limit),

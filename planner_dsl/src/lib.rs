@@ -77,6 +77,7 @@ mod limits;
 mod plan;
 mod registry;
 mod trace;
+pub mod typed;
 mod validate;
 mod value;
 

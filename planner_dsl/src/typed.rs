@@ -1,0 +1,570 @@
+//! The typed plan: the straight-line part of a script as typed steps and targets, so
+//! that checks, dry runs and repair prompts work on values instead of on text.
+//!
+//! [`TypedPlan::parse`] reads a script made of `let x = <pick>;` bindings and library
+//! calls (as `f(..)` or `agent.f(..)`) with literal or variable arguments;
+//! [`TypedPlan::to_rhai`] prints it back as ordinary Rhai that [`crate::Plan`] runs.
+//! Printing then parsing gives the same plan (tested on every reference plan of the
+//! example suites). Anything else (loops, conditions, functions, computed arguments)
+//! is an error naming the line and column: such scripts stay ordinary validated Rhai.
+//!
+//! ```
+//! use planner_dsl::typed::{Object, Step, TypedPlan};
+//! let p = TypedPlan::parse(
+//!     "let t = agent.get_obj_attributes(\"table\", 2, \"yellow\", \"west_to_east\");\nagent.move_to_object(t);",
+//! )
+//! .unwrap();
+//! assert_eq!(p.steps.len(), 2);
+//! assert_eq!(p.steps[1], Step::GoTo(Object::Var("t".into())));
+//! assert_eq!(TypedPlan::parse(&p.to_rhai()).unwrap(), p);
+//! ```
+
+use std::fmt::Write as _;
+
+use rhai::{Expr, FnCallExpr, Stmt};
+use serde::{Deserialize, Serialize};
+
+use crate::error::Span;
+
+/// Which object a noun phrase means: design.md's selection fields.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Target {
+    /// The category as said.
+    pub name: String,
+    /// k >= 1 the k-th, -1 the last, 0 unspecified (the first in the order).
+    #[serde(default)]
+    pub ordinal: i64,
+    /// Only this colour.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<String>,
+    /// Not this colour.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub not_colour: Option<String>,
+    /// The order the ordinal counts in (an order name), if not the default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<String>,
+    /// Only objects in this region.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<String>,
+    /// Ranked by distance from this object.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub near: Option<Box<Object>>,
+}
+
+/// An object argument.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Object {
+    /// A selection made where it is used.
+    Pick(Target),
+    /// A bare name: the nearest object of that name, or a region.
+    Name(String),
+    /// A variable bound by an earlier [`Step::Let`].
+    Var(String),
+}
+
+/// The side functions: a move to one side of an object, or a turn putting it on one side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// `move_to_left`.
+    Left,
+    /// `move_to_right`.
+    Right,
+    /// `move_north`.
+    North,
+    /// `move_south`.
+    South,
+    /// `move_east`.
+    East,
+    /// `move_west`.
+    West,
+    /// `with_object_on_left` (a turn).
+    OnLeft,
+    /// `with_object_on_right` (a turn).
+    OnRight,
+}
+
+impl Side {
+    const ALL: [(Side, &'static str); 8] = [
+        (Side::Left, "move_to_left"),
+        (Side::Right, "move_to_right"),
+        (Side::North, "move_north"),
+        (Side::South, "move_south"),
+        (Side::East, "move_east"),
+        (Side::West, "move_west"),
+        (Side::OnLeft, "with_object_on_left"),
+        (Side::OnRight, "with_object_on_right"),
+    ];
+
+    /// The library function.
+    #[must_use]
+    pub fn function(self) -> &'static str {
+        Side::ALL
+            .iter()
+            .find(|(s, _)| *s == self)
+            .map_or("move_to_left", |(_, f)| f)
+    }
+
+    fn from_function(f: &str) -> Option<Side> {
+        Side::ALL.iter().find(|(_, n)| *n == f).map(|(s, _)| *s)
+    }
+}
+
+/// One step of a straight-line plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Step {
+    /// `let var = <pick>;`: the object is chosen here (where the robot is now).
+    Let {
+        /// The variable.
+        var: String,
+        /// What it names.
+        target: Target,
+    },
+    /// `move_to_object`.
+    GoTo(Object),
+    /// A side of an object (see [`Side`]).
+    Side {
+        /// Which side function.
+        side: Side,
+        /// Of what.
+        object: Object,
+    },
+    /// `move_in_between(a, b)`.
+    Between(Object, Object),
+    /// `move_between_the_two(...)`: exactly two objects match.
+    BetweenTwo(Target),
+    /// `face`.
+    Face(Object),
+    /// `turn(angle)`, degrees clockwise.
+    Turn(f64),
+    /// `turn_absolute(heading)`, compass degrees.
+    TurnAbsolute(f64),
+    /// `move_forward(metres)`.
+    Forward(f64),
+    /// `move_to([x, y])`.
+    MoveTo([f64; 2]),
+    /// `move_to_start()`: back to where the plan began.
+    ToStart,
+    /// `say(text)`.
+    Say(String),
+}
+
+/// A straight-line plan.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct TypedPlan {
+    /// The steps in order.
+    pub steps: Vec<Step>,
+}
+
+/// Why a script is not a straight-line plan of library calls.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TypedError {
+    /// Not valid Rhai.
+    #[error("{span}: {message}")]
+    Parse {
+        /// Where.
+        span: Span,
+        /// The parser's message.
+        message: String,
+    },
+    /// A statement or argument the typed plan does not hold (a loop, a condition, a
+    /// computed argument, a function that is not a step or a pick).
+    #[error("{span}: {what} is not part of a straight-line plan")]
+    NotStraightLine {
+        /// Where.
+        span: Span,
+        /// What was found.
+        what: String,
+    },
+    /// A variable used before any `let` bound it.
+    #[error("{span}: variable `{name}` is not bound by an earlier `let`")]
+    UnknownVariable {
+        /// Where.
+        span: Span,
+        /// The variable.
+        name: String,
+    },
+    /// A call with the wrong number or kind of arguments.
+    #[error("{span}: {function}: {message}")]
+    Argument {
+        /// Where.
+        span: Span,
+        /// The function.
+        function: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+fn not_straight(pos: rhai::Position, what: impl Into<String>) -> TypedError {
+    TypedError::NotStraightLine {
+        span: Span::from_position(pos),
+        what: what.into(),
+    }
+}
+
+/// A library call: `f(..)` or `agent.f(..)`.
+fn call_of(e: &Expr) -> Option<(&FnCallExpr, rhai::Position)> {
+    match e {
+        Expr::FnCall(x, p) => Some((x, *p)),
+        Expr::Dot(b, _, _) => match (&b.lhs, &b.rhs) {
+            (Expr::Variable(v, ..), Expr::MethodCall(x, p)) if v.1.as_str() == "agent" => {
+                Some((x, *p))
+            }
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+struct Reader {
+    vars: Vec<String>,
+}
+
+impl Reader {
+    fn arg_err(&self, pos: rhai::Position, f: &str, message: impl Into<String>) -> TypedError {
+        TypedError::Argument {
+            span: Span::from_position(pos),
+            function: f.to_string(),
+            message: message.into(),
+        }
+    }
+
+    fn string(&self, e: &Expr, f: &str) -> Result<String, TypedError> {
+        match e {
+            Expr::StringConstant(s, _) => Ok(s.to_string()),
+            other => Err(self.arg_err(other.position(), f, "expected a string literal")),
+        }
+    }
+
+    fn opt_string(&self, e: Option<&Expr>, f: &str) -> Result<Option<String>, TypedError> {
+        match e {
+            None | Some(Expr::Unit(_)) => Ok(None),
+            Some(e) => Ok(Some(self.string(e, f)?).filter(|s| !s.trim().is_empty())),
+        }
+    }
+
+    fn number(&self, e: &Expr, f: &str) -> Result<f64, TypedError> {
+        let x = self.literal_number(e, f)?;
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.arg_err(e.position(), f, "expected a finite number"))
+        }
+    }
+
+    fn literal_number(&self, e: &Expr, f: &str) -> Result<f64, TypedError> {
+        match e {
+            Expr::IntegerConstant(i, _) => Ok(*i as f64),
+            Expr::FloatConstant(x, _) => Ok(**x),
+            Expr::FnCall(x, _) if x.name.as_str() == "-" && x.args.len() == 1 => {
+                Ok(-self.literal_number(&x.args[0], f)?)
+            }
+            other => Err(self.arg_err(other.position(), f, "expected a number literal")),
+        }
+    }
+
+    fn int(&self, e: Option<&Expr>, f: &str) -> Result<i64, TypedError> {
+        match e {
+            None | Some(Expr::Unit(_)) => Ok(0),
+            Some(Expr::IntegerConstant(i, _)) => Ok(*i),
+            Some(Expr::FnCall(x, _)) if x.name.as_str() == "-" && x.args.len() == 1 => {
+                Ok(-self.int(x.args.first(), f)?)
+            }
+            Some(other) => Err(self.arg_err(other.position(), f, "expected an integer literal")),
+        }
+    }
+
+    fn object(&self, e: &Expr, f: &str) -> Result<Object, TypedError> {
+        match e {
+            Expr::StringConstant(s, _) => Ok(Object::Name(s.to_string())),
+            Expr::Variable(v, _, p) => {
+                let name = v.1.to_string();
+                if self.vars.contains(&name) {
+                    Ok(Object::Var(name))
+                } else {
+                    Err(TypedError::UnknownVariable {
+                        span: Span::from_position(*p),
+                        name,
+                    })
+                }
+            }
+            other => match call_of(other) {
+                Some((x, p)) => Ok(Object::Pick(self.pick(x, p)?)),
+                None => Err(self.arg_err(other.position(), f, "expected an object")),
+            },
+        }
+    }
+
+    /// A pick: get_obj_attributes, get_obj_in_region, get_obj.
+    fn pick(&self, x: &FnCallExpr, p: rhai::Position) -> Result<Target, TypedError> {
+        let f = x.name.as_str();
+        let a: Vec<&Expr> = x.args.iter().collect();
+        let arity = |lo: usize, hi: usize| {
+            if (lo..=hi).contains(&a.len()) {
+                Ok(())
+            } else {
+                Err(self.arg_err(
+                    p,
+                    f,
+                    format!("takes {lo} to {hi} arguments, got {}", a.len()),
+                ))
+            }
+        };
+        match f {
+            "get_obj_attributes" => {
+                arity(1, 4)?;
+                Ok(Target {
+                    name: self.string(a[0], f)?,
+                    ordinal: self.int(a.get(1).copied(), f)?,
+                    colour: self.opt_string(a.get(2).copied(), f)?,
+                    order: self.opt_string(a.get(3).copied(), f)?,
+                    ..Target::default()
+                })
+            }
+            "get_obj_in_region" => {
+                arity(2, 5)?;
+                Ok(Target {
+                    name: self.string(a[0], f)?,
+                    region: Some(self.string(a[1], f)?),
+                    ordinal: self.int(a.get(2).copied(), f)?,
+                    colour: self.opt_string(a.get(3).copied(), f)?,
+                    order: self.opt_string(a.get(4).copied(), f)?,
+                    ..Target::default()
+                })
+            }
+            "get_obj" | "move_between_the_two" => {
+                arity(1, 2)?;
+                let mut t = Target {
+                    name: self.string(a[0], f)?,
+                    ..Target::default()
+                };
+                match a.get(1) {
+                    None | Some(Expr::Unit(_)) => {}
+                    Some(Expr::Map(m, _)) => {
+                        for (key, v) in &m.0 {
+                            match key.name.as_str() {
+                                "ordinal" => t.ordinal = self.int(Some(v), f)?,
+                                "colour" | "color" => t.colour = self.opt_string(Some(v), f)?,
+                                "not_colour" | "not_color" => {
+                                    t.not_colour = self.opt_string(Some(v), f)?;
+                                }
+                                "order" => t.order = self.opt_string(Some(v), f)?,
+                                "region" => t.region = self.opt_string(Some(v), f)?,
+                                "near" => t.near = Some(Box::new(self.object(v, f)?)),
+                                other => {
+                                    return Err(self.arg_err(
+                                        key.pos,
+                                        f,
+                                        format!("unknown key `{other}`"),
+                                    ))
+                                }
+                            }
+                        }
+                    }
+                    Some(other) => {
+                        return Err(self.arg_err(other.position(), f, "expected a map #{...}"))
+                    }
+                }
+                Ok(t)
+            }
+            _ => Err(not_straight(p, format!("`{f}(..)` as an object"))),
+        }
+    }
+
+    fn step(&mut self, s: &Stmt) -> Result<Step, TypedError> {
+        match s {
+            Stmt::Var(x, _, p) => {
+                let (ident, value, _) = x.as_ref();
+                let (c, cp) =
+                    call_of(value).ok_or_else(|| not_straight(*p, "a `let` of a non-pick"))?;
+                let target = self.pick(c, cp)?;
+                self.vars.push(ident.name.to_string());
+                Ok(Step::Let {
+                    var: ident.name.to_string(),
+                    target,
+                })
+            }
+            Stmt::FnCall(x, p) => self.call(x, *p),
+            Stmt::Expr(e) => match call_of(e) {
+                Some((x, p)) => self.call(x, p),
+                None => Err(not_straight(e.position(), "an expression statement")),
+            },
+            other => Err(not_straight(other.position(), "this statement")),
+        }
+    }
+
+    fn call(&self, x: &FnCallExpr, p: rhai::Position) -> Result<Step, TypedError> {
+        let f = x.name.as_str();
+        let a: Vec<&Expr> = x.args.iter().collect();
+        let n = |k: usize| {
+            if a.len() == k {
+                Ok(())
+            } else {
+                Err(self.arg_err(p, f, format!("takes {k} argument(s), got {}", a.len())))
+            }
+        };
+        if let Some(side) = Side::from_function(f) {
+            n(1)?;
+            return Ok(Step::Side {
+                side,
+                object: self.object(a[0], f)?,
+            });
+        }
+        match f {
+            "move_to_object" => n(1).and_then(|()| Ok(Step::GoTo(self.object(a[0], f)?))),
+            "face" => n(1).and_then(|()| Ok(Step::Face(self.object(a[0], f)?))),
+            "move_in_between" => {
+                n(2)?;
+                Ok(Step::Between(self.object(a[0], f)?, self.object(a[1], f)?))
+            }
+            "move_between_the_two" => Ok(Step::BetweenTwo(self.pick(x, p)?)),
+            "turn" => n(1).and_then(|()| Ok(Step::Turn(self.number(a[0], f)?))),
+            "turn_absolute" => n(1).and_then(|()| Ok(Step::TurnAbsolute(self.number(a[0], f)?))),
+            "move_forward" => n(1).and_then(|()| Ok(Step::Forward(self.number(a[0], f)?))),
+            "move_to_start" => n(0).map(|()| Step::ToStart),
+            "say" => n(1).and_then(|()| Ok(Step::Say(self.string(a[0], f)?))),
+            "move_to" => {
+                n(1)?;
+                match a[0] {
+                    Expr::Array(xs, _) if xs.len() == 2 => Ok(Step::MoveTo([
+                        self.number(&xs[0], f)?,
+                        self.number(&xs[1], f)?,
+                    ])),
+                    other => Err(self.arg_err(other.position(), f, "expected [x, y]")),
+                }
+            }
+            _ => Err(not_straight(p, format!("a call of `{f}`"))),
+        }
+    }
+}
+
+/// A Rhai string literal.
+fn lit(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\t' => out.push_str("\\t"),
+            '\r' => out.push_str("\\r"),
+            c if (c as u32) < 0x20 || c == '\u{7f}' => {
+                let _ = write!(out, "\\x{:02x}", c as u32);
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+fn num(x: f64) -> String {
+    if x.fract() == 0.0 && x.abs() < 1e15 {
+        format!("{x:.1}")
+    } else {
+        format!("{x}")
+    }
+}
+
+impl Target {
+    /// The canonical call: `get_obj("name", #{...})`, keys only where not default.
+    fn to_rhai(&self, function: &str) -> String {
+        let mut keys = Vec::new();
+        if self.ordinal != 0 {
+            keys.push(format!("ordinal: {}", self.ordinal));
+        }
+        for (k, v) in [
+            ("colour", &self.colour),
+            ("not_colour", &self.not_colour),
+            ("order", &self.order),
+            ("region", &self.region),
+        ] {
+            if let Some(v) = v {
+                keys.push(format!("{k}: {}", lit(v)));
+            }
+        }
+        if let Some(o) = &self.near {
+            keys.push(format!("near: {}", o.to_rhai()));
+        }
+        if keys.is_empty() {
+            format!("agent.{function}({})", lit(&self.name))
+        } else {
+            format!(
+                "agent.{function}({}, #{{{}}})",
+                lit(&self.name),
+                keys.join(", ")
+            )
+        }
+    }
+}
+
+impl Object {
+    fn to_rhai(&self) -> String {
+        match self {
+            Object::Pick(t) => t.to_rhai("get_obj"),
+            Object::Name(n) => lit(n),
+            Object::Var(v) => v.clone(),
+        }
+    }
+}
+
+impl TypedPlan {
+    /// Reads a straight-line script.
+    ///
+    /// # Errors
+    /// [`TypedError`] with the line and column of the first statement or argument the
+    /// typed plan does not hold.
+    pub fn parse(src: &str) -> Result<TypedPlan, TypedError> {
+        let mut engine = rhai::Engine::new_raw();
+        engine.set_optimization_level(rhai::OptimizationLevel::None);
+        let ast = engine.compile(src).map_err(|e| TypedError::Parse {
+            span: Span::from_position(e.position()),
+            message: e.err_type().to_string(),
+        })?;
+        if let Some(f) = ast.iter_functions().next() {
+            return Err(TypedError::NotStraightLine {
+                span: Span { line: 0, col: 0 },
+                what: format!("the script function `{}`", f.name),
+            });
+        }
+        let mut reader = Reader { vars: Vec::new() };
+        let steps = ast
+            .statements()
+            .iter()
+            .map(|s| reader.step(s))
+            .collect::<Result<_, _>>()?;
+        Ok(TypedPlan { steps })
+    }
+
+    /// The plan as Rhai, one statement per line, picks in their canonical form.
+    #[must_use]
+    pub fn to_rhai(&self) -> String {
+        let mut out = String::new();
+        for s in &self.steps {
+            let line = match s {
+                Step::Let { var, target } => format!("let {var} = {};", target.to_rhai("get_obj")),
+                Step::GoTo(o) => format!("agent.move_to_object({});", o.to_rhai()),
+                Step::Side { side, object } => {
+                    format!("agent.{}({});", side.function(), object.to_rhai())
+                }
+                Step::Between(a, b) => {
+                    format!("agent.move_in_between({}, {});", a.to_rhai(), b.to_rhai())
+                }
+                Step::BetweenTwo(t) => format!("{};", t.to_rhai("move_between_the_two")),
+                Step::Face(o) => format!("agent.face({});", o.to_rhai()),
+                Step::Turn(a) => format!("agent.turn({});", num(*a)),
+                Step::TurnAbsolute(a) => format!("agent.turn_absolute({});", num(*a)),
+                Step::Forward(d) => format!("agent.move_forward({});", num(*d)),
+                Step::MoveTo([x, y]) => format!("agent.move_to([{}, {}]);", num(*x), num(*y)),
+                Step::ToStart => "agent.move_to_start();".to_string(),
+                Step::Say(t) => format!("say({});", lit(t)),
+            };
+            let _ = writeln!(out, "{line}");
+        }
+        out
+    }
+}

@@ -1,0 +1,187 @@
+//! The typed plan: every reference plan of the example suites parses into typed steps,
+//! prints back to Rhai that parses to the same steps, and the printed script drives the
+//! robot to the same stops as the original. Non-straight-line scripts are refused with
+//! their position; printing is proptested for round trips.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::world;
+use planner_dsl::typed::{Object, Side, Step, Target, TypedError, TypedPlan};
+use planner_dsl::{run, Limits, Plan, Span};
+use proptest::prelude::*;
+
+fn reference_plans() -> Vec<(String, String, String)> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/suites");
+    let mut out = Vec::new();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with(".nav.jsonl"))
+        .collect();
+    files.sort();
+    for f in files {
+        for line in std::fs::read_to_string(&f).unwrap().lines() {
+            if line.trim().is_empty() {
+                continue;
+            }
+            let v: serde_json::Value = serde_json::from_str(line).unwrap();
+            if let Some(r) = v["reference"].as_str() {
+                let scene = v["scene"].as_str().unwrap();
+                let scene = scene
+                    .rsplit('/')
+                    .next()
+                    .unwrap()
+                    .trim_end_matches(".scene.json");
+                out.push((
+                    v["id"].as_str().unwrap().to_string(),
+                    scene.to_string(),
+                    r.to_string(),
+                ));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn every_reference_plan_round_trips_and_runs_the_same() {
+    let plans = reference_plans();
+    assert!(plans.len() >= 70, "{} reference plans", plans.len());
+    for (id, scene, src) in plans {
+        let typed = TypedPlan::parse(&src).unwrap_or_else(|e| panic!("{id}: {e}\n{src}"));
+        let printed = typed.to_rhai();
+        assert_eq!(
+            TypedPlan::parse(&printed).unwrap(),
+            typed,
+            "{id}:\n{printed}"
+        );
+        let (map, _) = world(&scene);
+        let stops = |s: &str| {
+            let mut robot = map_core::SimRobot::new(map.clone());
+            let out = run(
+                &Plan::compile(s).unwrap(),
+                &map,
+                &mut robot,
+                &Limits::default(),
+            );
+            assert!(out.error.is_none(), "{id}: {:?}\n{s}", out.error);
+            use map_core::Robot;
+            robot.trajectory().stops.clone()
+        };
+        let (a, b) = (stops(&src), stops(&printed));
+        assert_eq!(a.len(), b.len(), "{id}");
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x.target, y.target, "{id}");
+            assert!(
+                (x.pose[0] - y.pose[0]).abs() < 1e-9 && (x.pose[1] - y.pose[1]).abs() < 1e-9,
+                "{id}"
+            );
+        }
+    }
+}
+
+#[test]
+fn selections_nest_and_print_canonically() {
+    let p = TypedPlan::parse(
+        "let t = agent.get_obj(\"table\", #{colour: \"red\"});\n\
+         agent.move_to_left(get_obj(\"chair\", #{ordinal: 2, near: t, not_colour: \"black\"}));\n\
+         move_between_the_two(\"sofa\");\nagent.turn(-90);\nmove_to_start();\nsay(\"done \\\"ok\\\"\");",
+    )
+    .unwrap();
+    assert_eq!(
+        p.steps[1],
+        Step::Side {
+            side: Side::Left,
+            object: Object::Pick(Target {
+                name: "chair".into(),
+                ordinal: 2,
+                not_colour: Some("black".into()),
+                near: Some(Box::new(Object::Var("t".into()))),
+                ..Target::default()
+            })
+        }
+    );
+    assert_eq!(p.steps[3], Step::Turn(-90.0));
+    assert_eq!(
+        p.to_rhai(),
+        "let t = agent.get_obj(\"table\", #{colour: \"red\"});\n\
+         agent.move_to_left(agent.get_obj(\"chair\", #{ordinal: 2, not_colour: \"black\", near: t}));\n\
+         agent.move_between_the_two(\"sofa\");\nagent.turn(-90.0);\nagent.move_to_start();\nsay(\"done \\\"ok\\\"\");\n"
+    );
+}
+
+#[test]
+fn what_is_not_straight_line_is_refused_with_its_position() {
+    let e = TypedPlan::parse("agent.move_to_object(\"sofa\");\nfor i in 0..3 { turn(90); }")
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            TypedError::NotStraightLine {
+                span: Span { line: 2, .. },
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = TypedPlan::parse("move_to_object(x);").unwrap_err();
+    assert!(matches!(e, TypedError::UnknownVariable { .. }), "{e}");
+    let e = TypedPlan::parse("turn(1 + 2);").unwrap_err();
+    assert!(matches!(e, TypedError::Argument { .. }), "{e}");
+    let e = TypedPlan::parse("move_to_object(\"sofa\"").unwrap_err();
+    assert!(matches!(e, TypedError::Parse { .. }), "{e}");
+    let e = TypedPlan::parse("fn f() { 1 }\nsay(\"x\");").unwrap_err();
+    assert!(e.to_string().contains("script function"), "{e}");
+}
+
+fn arb_target() -> impl Strategy<Value = Target> {
+    let s = "[a-z \"\\\\\n\t]{0,8}";
+    (
+        "[a-z][a-z ]{0,8}",
+        -1i64..20,
+        proptest::option::of(s),
+        proptest::option::of(s),
+        proptest::option::of(s),
+        proptest::option::of(s),
+    )
+        .prop_map(|(name, ordinal, colour, not_colour, order, region)| {
+            let nonempty = |o: Option<String>| o.filter(|x| !x.trim().is_empty());
+            Target {
+                name,
+                ordinal,
+                colour: nonempty(colour),
+                not_colour: nonempty(not_colour),
+                order: nonempty(order),
+                region: nonempty(region),
+                near: None,
+            }
+        })
+}
+
+proptest! {
+    #[test]
+    fn printed_plans_parse_back_to_themselves(
+        t in arb_target(),
+        near in proptest::option::of(arb_target()),
+        angle in -720.0f64..720.0,
+        text in "\\PC{0,12}",
+    ) {
+        let mut t = t;
+        t.near = near.map(|n| Box::new(Object::Pick(n)));
+        let p = TypedPlan {
+            steps: vec![
+                Step::Let { var: "x".into(), target: t.clone() },
+                Step::GoTo(Object::Var("x".into())),
+                Step::Face(Object::Pick(t.clone())),
+                Step::BetweenTwo(t),
+                Step::Turn(angle),
+                Step::Say(text),
+            ],
+        };
+        prop_assert_eq!(TypedPlan::parse(&p.to_rhai()).unwrap(), p);
+    }
+}
