@@ -56,8 +56,12 @@ use crate::query::{ObjectOrder, QueryError};
 /// Which instance a noun phrase means: a category name, filters, an order and an
 /// ordinal. Built with [`Selection::new`] and the builder methods; resolved by
 /// [`IvlMap::select`].
-#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub struct Selection {
+///
+/// `A` is how the anchor of "next to" is held: an instance id here (resolved); the plan
+/// language's typed plan holds the object expression instead
+/// (`planner_dsl::typed::Target`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Selection<A = u32> {
     /// The category as said ("couch" finds the sofas through the matcher).
     pub name: String,
     /// k >= 1 the k-th in the order, -1 the last, 0 the first (unspecified).
@@ -77,11 +81,25 @@ pub struct Selection {
     pub region: Option<String>,
     /// An anchor instance id: distances (near_to_far, far_to_near) are measured from its
     /// footprint instead of from the robot, and the anchor itself is left out.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub near: Option<u32>,
+    #[serde(default = "Option::default", skip_serializing_if = "Option::is_none")]
+    pub near: Option<A>,
 }
 
-impl Selection {
+impl<A> Default for Selection<A> {
+    fn default() -> Self {
+        Selection {
+            name: String::new(),
+            ordinal: 0,
+            colour: None,
+            not_colour: None,
+            order: ObjectOrder::default(),
+            region: None,
+            near: None,
+        }
+    }
+}
+
+impl<A> Selection<A> {
     /// Any instance called `name`; the first in the default order (the nearest).
     #[must_use]
     pub fn new(name: impl Into<String>) -> Self {
@@ -128,9 +146,9 @@ impl Selection {
         self
     }
 
-    /// Ranked by distance from the footprint of instance `anchor`.
+    /// Ranked by distance from the footprint of `anchor`.
     #[must_use]
-    pub fn near(mut self, anchor: u32) -> Self {
+    pub fn near(mut self, anchor: A) -> Self {
         self.near = Some(anchor);
         self
     }

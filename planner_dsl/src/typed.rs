@@ -24,32 +24,14 @@ use std::fmt::Write as _;
 use rhai::{Expr, FnCallExpr, Stmt};
 use serde::{Deserialize, Serialize};
 
+use map_core::select::Selection;
+use map_core::ObjectOrder;
+
 use crate::error::Span;
 
-/// Which object a noun phrase means: design.md's selection fields.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-pub struct Target {
-    /// The category as said.
-    pub name: String,
-    /// k >= 1 the k-th, -1 the last, 0 unspecified (the first in the order).
-    #[serde(default)]
-    pub ordinal: i64,
-    /// Only this colour.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub colour: Option<String>,
-    /// Not this colour.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub not_colour: Option<String>,
-    /// The order the ordinal counts in (an order name), if not the default.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub order: Option<String>,
-    /// Only objects in this region.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub region: Option<String>,
-    /// Ranked by distance from this object.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub near: Option<Box<Object>>,
-}
+/// Which object a noun phrase means: design.md's selection, its "next to" anchor held
+/// as the object expression the script wrote (resolved to an instance id at run time).
+pub type Target = Selection<Box<Object>>;
 
 /// An object argument.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -246,6 +228,19 @@ impl Reader {
         }
     }
 
+    fn order(&self, e: Option<&Expr>, f: &str) -> Result<ObjectOrder, TypedError> {
+        match self.opt_string(e, f)? {
+            None => Ok(ObjectOrder::default()),
+            Some(o) => ObjectOrder::parse(&o).map_err(|err| {
+                self.arg_err(
+                    e.map_or(rhai::Position::NONE, Expr::position),
+                    f,
+                    err.to_string(),
+                )
+            }),
+        }
+    }
+
     fn number(&self, e: &Expr, f: &str) -> Result<f64, TypedError> {
         let x = self.literal_number(e, f)?;
         if x.is_finite() {
@@ -320,7 +315,7 @@ impl Reader {
                     name: self.string(a[0], f)?,
                     ordinal: self.int(a.get(1).copied(), f)?,
                     colour: self.opt_string(a.get(2).copied(), f)?,
-                    order: self.opt_string(a.get(3).copied(), f)?,
+                    order: self.order(a.get(3).copied(), f)?,
                     ..Target::default()
                 })
             }
@@ -331,7 +326,7 @@ impl Reader {
                     region: Some(self.string(a[1], f)?),
                     ordinal: self.int(a.get(2).copied(), f)?,
                     colour: self.opt_string(a.get(3).copied(), f)?,
-                    order: self.opt_string(a.get(4).copied(), f)?,
+                    order: self.order(a.get(4).copied(), f)?,
                     ..Target::default()
                 })
             }
@@ -351,7 +346,7 @@ impl Reader {
                                 "not_colour" | "not_color" => {
                                     t.not_colour = self.opt_string(Some(v), f)?;
                                 }
-                                "order" => t.order = self.opt_string(Some(v), f)?,
+                                "order" => t.order = self.order(Some(v), f)?,
                                 "region" => t.region = self.opt_string(Some(v), f)?,
                                 "near" => t.near = Some(Box::new(self.object(v, f)?)),
                                 other => {
@@ -470,42 +465,42 @@ fn num(x: f64) -> String {
     }
 }
 
-impl Target {
-    /// The canonical call: `get_obj("name", #{...})`, keys only where not default.
-    fn to_rhai(&self, function: &str) -> String {
-        let mut keys = Vec::new();
-        if self.ordinal != 0 {
-            keys.push(format!("ordinal: {}", self.ordinal));
+/// The canonical call of a target: `agent.get_obj("name", #{...})` (or another function
+/// taking a selection), keys only where not default.
+fn target_call(t: &Target, function: &str) -> String {
+    let mut keys = Vec::new();
+    if t.ordinal != 0 {
+        keys.push(format!("ordinal: {}", t.ordinal));
+    }
+    for (k, v) in [("colour", &t.colour), ("not_colour", &t.not_colour)] {
+        if let Some(v) = v {
+            keys.push(format!("{k}: {}", lit(v)));
         }
-        for (k, v) in [
-            ("colour", &self.colour),
-            ("not_colour", &self.not_colour),
-            ("order", &self.order),
-            ("region", &self.region),
-        ] {
-            if let Some(v) = v {
-                keys.push(format!("{k}: {}", lit(v)));
-            }
-        }
-        if let Some(o) = &self.near {
-            keys.push(format!("near: {}", o.to_rhai()));
-        }
-        if keys.is_empty() {
-            format!("agent.{function}({})", lit(&self.name))
-        } else {
-            format!(
-                "agent.{function}({}, #{{{}}})",
-                lit(&self.name),
-                keys.join(", ")
-            )
-        }
+    }
+    if t.order != ObjectOrder::default() {
+        keys.push(format!("order: {}", lit(t.order.name())));
+    }
+    if let Some(v) = &t.region {
+        keys.push(format!("region: {}", lit(v)));
+    }
+    if let Some(o) = &t.near {
+        keys.push(format!("near: {}", o.to_rhai()));
+    }
+    if keys.is_empty() {
+        format!("agent.{function}({})", lit(&t.name))
+    } else {
+        format!(
+            "agent.{function}({}, #{{{}}})",
+            lit(&t.name),
+            keys.join(", ")
+        )
     }
 }
 
 impl Object {
     fn to_rhai(&self) -> String {
         match self {
-            Object::Pick(t) => t.to_rhai("get_obj"),
+            Object::Pick(t) => target_call(t, "get_obj"),
             Object::Name(n) => lit(n),
             Object::Var(v) => v.clone(),
         }
@@ -546,7 +541,9 @@ impl TypedPlan {
         let mut out = String::new();
         for s in &self.steps {
             let line = match s {
-                Step::Let { var, target } => format!("let {var} = {};", target.to_rhai("get_obj")),
+                Step::Let { var, target } => {
+                    format!("let {var} = {};", target_call(target, "get_obj"))
+                }
                 Step::GoTo(o) => format!("agent.move_to_object({});", o.to_rhai()),
                 Step::Side { side, object } => {
                     format!("agent.{}({});", side.function(), object.to_rhai())
@@ -554,7 +551,7 @@ impl TypedPlan {
                 Step::Between(a, b) => {
                     format!("agent.move_in_between({}, {});", a.to_rhai(), b.to_rhai())
                 }
-                Step::BetweenTwo(t) => format!("{};", t.to_rhai("move_between_the_two")),
+                Step::BetweenTwo(t) => format!("{};", target_call(t, "move_between_the_two")),
                 Step::Face(o) => format!("agent.face({});", o.to_rhai()),
                 Step::Turn(a) => format!("agent.turn({});", num(*a)),
                 Step::TurnAbsolute(a) => format!("agent.turn_absolute({});", num(*a)),

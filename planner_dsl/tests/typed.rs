@@ -10,6 +10,7 @@ mod common;
 use std::path::PathBuf;
 
 use common::world;
+use map_core::ObjectOrder;
 use planner_dsl::typed::{Object, Side, Step, Target, TypedError, TypedPlan};
 use planner_dsl::{run, Limits, Plan, Span};
 use proptest::prelude::*;
@@ -145,7 +146,7 @@ fn arb_target() -> impl Strategy<Value = Target> {
         -1i64..20,
         proptest::option::of(s),
         proptest::option::of(s),
-        proptest::option::of(s),
+        0..ObjectOrder::ALL.len(),
         proptest::option::of(s),
     )
         .prop_map(|(name, ordinal, colour, not_colour, order, region)| {
@@ -155,7 +156,7 @@ fn arb_target() -> impl Strategy<Value = Target> {
                 ordinal,
                 colour: nonempty(colour),
                 not_colour: nonempty(not_colour),
-                order: nonempty(order),
+                order: ObjectOrder::ALL[order].0,
                 region: nonempty(region),
                 near: None,
             }
