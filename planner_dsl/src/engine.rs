@@ -136,105 +136,25 @@ where
 fn register_library_fn(m: &mut Module, spec: &'static FunctionSpec, arity: usize) {
     type Ctx<'a> = NativeCallContext<'a>;
     type H<'a> = &'a mut AgentHandle;
-    let n = spec.name;
+    // Rhai registers a native function per parameter count: one pair per arity.
+    macro_rules! both_forms {
+        ($($a:ident),*) => {{
+            reg(m, spec.name, move |c: Ctx<'_>, $($a: Dynamic),*| {
+                dispatch(&c, spec, vec![$($a),*])
+            });
+            reg(m, spec.name, move |c: Ctx<'_>, _: H<'_>, $($a: Dynamic),*| {
+                dispatch(&c, spec, vec![$($a),*])
+            });
+        }};
+    }
     match arity {
-        0 => {
-            reg(m, n, move |c: Ctx<'_>| dispatch(&c, spec, vec![]));
-            reg(m, n, move |c: Ctx<'_>, _: H<'_>| dispatch(&c, spec, vec![]));
-        }
-        1 => {
-            reg(m, n, move |c: Ctx<'_>, a: Dynamic| {
-                dispatch(&c, spec, vec![a])
-            });
-            reg(m, n, move |c: Ctx<'_>, _: H<'_>, a: Dynamic| {
-                dispatch(&c, spec, vec![a])
-            });
-        }
-        2 => {
-            reg(m, n, move |c: Ctx<'_>, a: Dynamic, b: Dynamic| {
-                dispatch(&c, spec, vec![a, b])
-            });
-            reg(m, n, move |c: Ctx<'_>, _: H<'_>, a: Dynamic, b: Dynamic| {
-                dispatch(&c, spec, vec![a, b])
-            });
-        }
-        3 => {
-            reg(
-                m,
-                n,
-                move |c: Ctx<'_>, a: Dynamic, b: Dynamic, d: Dynamic| {
-                    dispatch(&c, spec, vec![a, b, d])
-                },
-            );
-            reg(
-                m,
-                n,
-                move |c: Ctx<'_>, _: H<'_>, a: Dynamic, b: Dynamic, d: Dynamic| {
-                    dispatch(&c, spec, vec![a, b, d])
-                },
-            );
-        }
-        4 => {
-            reg(
-                m,
-                n,
-                move |c: Ctx<'_>, a: Dynamic, b: Dynamic, d: Dynamic, e: Dynamic| {
-                    dispatch(&c, spec, vec![a, b, d, e])
-                },
-            );
-            reg(
-                m,
-                n,
-                move |c: Ctx<'_>, _: H<'_>, a: Dynamic, b: Dynamic, d: Dynamic, e: Dynamic| {
-                    dispatch(&c, spec, vec![a, b, d, e])
-                },
-            );
-        }
-        5 => {
-            reg(
-                m,
-                n,
-                move |c: Ctx<'_>, a: Dynamic, b: Dynamic, d: Dynamic, e: Dynamic, f: Dynamic| {
-                    dispatch(&c, spec, vec![a, b, d, e, f])
-                },
-            );
-            reg(
-                m,
-                n,
-                move |c: Ctx<'_>,
-                      _: H<'_>,
-                      a: Dynamic,
-                      b: Dynamic,
-                      d: Dynamic,
-                      e: Dynamic,
-                      f: Dynamic| { dispatch(&c, spec, vec![a, b, d, e, f]) },
-            );
-        }
-        _ => {
-            reg(
-                m,
-                n,
-                move |c: Ctx<'_>,
-                      a: Dynamic,
-                      b: Dynamic,
-                      d: Dynamic,
-                      e: Dynamic,
-                      f: Dynamic,
-                      g: Dynamic| { dispatch(&c, spec, vec![a, b, d, e, f, g]) },
-            );
-            reg(
-                m,
-                n,
-                move |c: Ctx<'_>,
-                      _: H<'_>,
-                      a: Dynamic,
-                      b: Dynamic,
-                      d: Dynamic,
-                      e: Dynamic,
-                      f: Dynamic,
-                      g: Dynamic| { dispatch(&c, spec, vec![a, b, d, e, f, g]) },
-            );
-        }
+        0 => both_forms!(),
+        1 => both_forms!(a),
+        2 => both_forms!(a, b),
+        3 => both_forms!(a, b, d),
+        4 => both_forms!(a, b, d, e),
+        5 => both_forms!(a, b, d, e, f),
+        _ => both_forms!(a, b, d, e, f, g),
     }
 }
 
