@@ -159,6 +159,14 @@ fn footprint_distance(a: &Instance, b: &Instance) -> f64 {
     closest_points(&a.contour, &b.contour).map_or(f64::INFINITY, |(p, q)| p.dist(q))
 }
 
+/// `noun` with the selection's colour in front ("yellow tables"), for messages.
+fn coloured<A>(noun: String, sel: &Selection<A>) -> String {
+    match given(sel.colour.as_deref()) {
+        Some(c) => format!("{c} {noun}"),
+        None => noun,
+    }
+}
+
 /// Trimmed, and `None` when empty.
 fn given(s: Option<&str>) -> Option<&str> {
     s.map(str::trim).filter(|c| !c.is_empty())
@@ -200,12 +208,8 @@ impl IvlMap {
             } else {
                 plural(&label)
             };
-            let what = match given(sel.colour.as_deref()) {
-                Some(c) => format!("{c} {noun}"),
-                None => noun,
-            };
             QueryError::OrdinalPastCount {
-                what,
+                what: coloured(noun, sel),
                 count: cands.len(),
                 k,
             }
@@ -223,10 +227,7 @@ impl IvlMap {
         match cands[..] {
             [a, b] => Ok([a, b]),
             _ => Err(QueryError::NotExactlyTwo {
-                what: match given(sel.colour.as_deref()) {
-                    Some(c) => format!("{c} {}", plural(&label)),
-                    None => plural(&label),
-                },
+                what: coloured(plural(&label), sel),
                 count: cands.len(),
                 ids: cands.iter().map(|i| i.id).collect(),
             }),
