@@ -15,6 +15,8 @@
 //! - [`pipeline`]: [`extract_tuples`], [`plan_instruction`] (resolution against the map,
 //!   deterministic plans for plain "go to X" sequences, the LLM path with a bounded repair
 //!   loop).
+//! - [`v2`]: the one-call language layer (typed answer, grammar from the registry and
+//!   the map, retrieved worked examples, checks that re-ask and ask, never rewrite).
 //! - [`session`]: a chat [`Session`] with history ("go back", "the other one").
 //!
 //! ```
@@ -37,11 +39,12 @@ pub mod script;
 pub mod session;
 pub mod template;
 pub mod tuples;
+pub mod v2;
 mod words;
 
 pub use pipeline::{
-    extract_tuples, plan_instruction, LanguageError, Outcome, PlanContext, PlanOptions, PlanSource,
-    PlannedInstruction, Timing,
+    extract_tuples, plan_instruction, LanguageError, Outcome, Pipeline, PlanContext, PlanOptions,
+    PlanSource, PlannedInstruction, Timing,
 };
 pub use prompts::{PromptError, Prompts};
 pub use session::{Session, Turn};

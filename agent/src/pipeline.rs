@@ -71,7 +71,7 @@ pub struct Timing {
 }
 
 impl Timing {
-    fn add(&mut self, c: &Completion) {
+    pub(crate) fn add(&mut self, c: &Completion) {
         self.llm_calls += 1;
         self.prompt_tokens += u64::from(c.prompt_tokens);
         self.cached_prompt_tokens += u64::from(c.cached_prompt_tokens);
@@ -122,6 +122,29 @@ pub struct PlanOptions {
     /// Constrain step 2's scripts with [`planner_dsl::script_grammar`] (default off: see
     /// README, "Grammars", for what it costs and changes).
     pub script_grammar: bool,
+    /// Which language layer plans (default [`Pipeline::V1`] until v2 wins on the
+    /// held-out set; see README).
+    pub pipeline: Pipeline,
+    /// v2: worked examples shown per instruction, the most similar to it (default 3).
+    pub examples: usize,
+    /// v2: hold the answer to the grammar of [`crate::v2::grammar::answer_grammar`]
+    /// (backends that take GBNF; default on).
+    pub answer_grammar: bool,
+    /// v2: send the grammar in Lark too, which the llama backend runs with llguidance
+    /// instead of GBNF (default on; off measures GBNF).
+    pub llguidance: bool,
+}
+
+/// Which language layer plans an instruction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Pipeline {
+    /// Two steps (tuples, then a script), word tables, alignment and a repair loop.
+    #[default]
+    V1,
+    /// One constrained call per instruction, typed checks, one re-ask, then a question
+    /// ([`crate::v2`]).
+    V2,
 }
 
 impl Default for PlanOptions {
@@ -137,6 +160,10 @@ impl Default for PlanOptions {
             tuple_check: true,
             reconcile: true,
             script_grammar: false,
+            pipeline: Pipeline::default(),
+            examples: 3,
+            answer_grammar: true,
+            llguidance: true,
         }
     }
 }
@@ -152,6 +179,9 @@ pub struct PlanContext<'a> {
     pub pose: Pose,
     /// A summary of the conversation so far (see [`crate::Session`]).
     pub history: Option<String>,
+    /// Object ids the conversation visited, which a v2 plan may name with
+    /// `get_instance` (see [`crate::Session::references`]).
+    pub references: Vec<u32>,
     /// Knobs.
     pub options: PlanOptions,
 }
@@ -166,6 +196,7 @@ impl<'a> PlanContext<'a> {
             robot: None,
             pose: map.start_pose,
             history: None,
+            references: Vec::new(),
             options: PlanOptions::default(),
         }
     }
@@ -179,7 +210,7 @@ impl<'a> PlanContext<'a> {
         self
     }
 
-    fn pose(&self) -> Pose {
+    pub(crate) fn pose(&self) -> Pose {
         use map_core::Robot as _;
         self.robot.map_or(self.pose, |r| r.pose())
     }
@@ -333,6 +364,9 @@ pub fn extract_tuples_in(
     options: &PlanOptions,
     lexicon: &Lexicon,
 ) -> Result<(Vec<Tuple>, Timing), LanguageError> {
+    if options.pipeline == Pipeline::V2 {
+        return crate::v2::extract(backend, prompts, instruction, options);
+    }
     let t0 = Instant::now();
     let settle = |tuples: Vec<Tuple>| {
         if !options.reconcile {
@@ -508,6 +542,9 @@ pub fn plan_instruction(
     instruction: &str,
     ctx: &PlanContext<'_>,
 ) -> Result<Outcome, LanguageError> {
+    if ctx.options.pipeline == Pipeline::V2 {
+        return crate::v2::plan_instruction(backend, prompts, instruction, ctx);
+    }
     let t0 = Instant::now();
     let scene = scene_summary(ctx.map);
     let extract_scene = ctx.options.scene_in_extract.then_some(scene.as_str());

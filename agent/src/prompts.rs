@@ -44,7 +44,14 @@ pub const TEMPLATE_NAMES: &[&str] = &[
     "codegen.md.j2",
     "plan_request.md.j2",
     "repair.md.j2",
+    "v2_system.md.j2",
+    "v2_request.md.j2",
+    "v2_reask.md.j2",
 ];
+
+/// The worked examples of the one-call answer (not a template: `> instruction` lines each
+/// followed by its answer; see [`crate::v2::examples`]). A variant folder may hold its own.
+pub const WORKED_EXAMPLES: &str = "worked_examples.txt";
 
 const BUILTIN: &[(&str, &str)] = &[
     ("system.md.j2", include_str!("../../prompts/system.md.j2")),
@@ -70,11 +77,33 @@ const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../prompts/plan_request.md.j2"),
     ),
     ("repair.md.j2", include_str!("../../prompts/repair.md.j2")),
+    (
+        "v2_system.md.j2",
+        include_str!("../../prompts/v2_system.md.j2"),
+    ),
+    (
+        "v2_request.md.j2",
+        include_str!("../../prompts/v2_request.md.j2"),
+    ),
+    (
+        "v2_reask.md.j2",
+        include_str!("../../prompts/v2_reask.md.j2"),
+    ),
+    (
+        WORKED_EXAMPLES,
+        include_str!("../../prompts/worked_examples.txt"),
+    ),
 ];
 
 /// A prompt file that could not be read or rendered.
 #[derive(Debug, thiserror::Error)]
 pub enum PromptError {
+    /// The worked examples file is malformed.
+    #[error(transparent)]
+    Examples(#[from] crate::v2::examples::ExamplesError),
+    /// The embedder given for example retrieval failed.
+    #[error(transparent)]
+    Embed(#[from] crate::v2::examples::EmbedFailure),
     /// A folder or file could not be read.
     #[error("prompt folder {}: {message}", path.display())]
     Io {
@@ -106,6 +135,8 @@ pub enum PromptError {
 pub struct Prompts {
     templates: BTreeMap<String, (String, String)>,
     label: String,
+    /// The worked examples ranked by an embedder, when one was given.
+    index: Option<std::sync::Arc<crate::v2::examples::ExampleIndex>>,
 }
 
 impl Default for Prompts {
@@ -139,6 +170,7 @@ impl Prompts {
         Self {
             templates,
             label: "builtin".into(),
+            index: None,
         }
     }
 
@@ -176,7 +208,10 @@ impl Prompts {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
             .map_err(|e| io(dir, e))?
             .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|x| x == "j2"))
+            .filter(|p| {
+                p.extension().is_some_and(|x| x == "j2")
+                    || p.file_name().is_some_and(|n| n == WORKED_EXAMPLES)
+            })
             .collect();
         entries.sort();
         for path in entries {
@@ -184,7 +219,7 @@ impl Prompts {
                 .file_name()
                 .map(|n| n.to_string_lossy().to_string())
                 .unwrap_or_default();
-            if !TEMPLATE_NAMES.contains(&name.as_str()) {
+            if !TEMPLATE_NAMES.contains(&name.as_str()) && name != WORKED_EXAMPLES {
                 return Err(PromptError::UnknownFile { path });
             }
             let text = std::fs::read_to_string(&path).map_err(|e| io(&path, e))?;
@@ -192,6 +227,7 @@ impl Prompts {
                 .insert(name, (text, path.display().to_string()));
         }
         self.label = dir.display().to_string();
+        self.index = None;
         self.check()?;
         Ok(self)
     }
@@ -216,9 +252,10 @@ impl Prompts {
 
     /// Parses every template (so that a broken variant fails at load time).
     fn check(&self) -> Result<(), PromptError> {
-        for name in self.templates.keys() {
+        for name in self.templates.keys().filter(|n| *n != WORKED_EXAMPLES) {
             self.env(name)?;
         }
+        self.worked_example_list()?;
         Ok(())
     }
 
@@ -357,6 +394,104 @@ impl Prompts {
             ChatMessage::system(self.plan_system()?),
             ChatMessage::user(user),
         ])
+    }
+
+    /// The worked examples, read.
+    ///
+    /// # Errors
+    /// [`PromptError::Examples`] naming the file and line.
+    pub fn worked_example_list(
+        &self,
+    ) -> Result<Vec<crate::v2::examples::WorkedExample>, PromptError> {
+        let (text, origin) = self.worked_examples();
+        Ok(crate::v2::examples::parse_examples(text, origin)?)
+    }
+
+    /// This set with its worked examples ranked by `embedder` (embedded once, here).
+    ///
+    /// # Errors
+    /// [`PromptError::Examples`], or [`PromptError::Embed`] when the embedder fails.
+    pub fn with_embedder(
+        mut self,
+        embedder: std::sync::Arc<dyn crate::v2::examples::Embedder>,
+    ) -> Result<Self, PromptError> {
+        let idx =
+            crate::v2::examples::ExampleIndex::embedded(self.worked_example_list()?, embedder)?;
+        self.index = Some(std::sync::Arc::new(idx));
+        Ok(self)
+    }
+
+    /// The worked examples ready to rank: embedded when [`Prompts::with_embedder`] was
+    /// called, else ranked by words.
+    ///
+    /// # Errors
+    /// [`PromptError::Examples`].
+    pub fn example_index(
+        &self,
+    ) -> Result<std::sync::Arc<crate::v2::examples::ExampleIndex>, PromptError> {
+        match &self.index {
+            Some(i) => Ok(i.clone()),
+            None => Ok(std::sync::Arc::new(
+                crate::v2::examples::ExampleIndex::lexical(self.worked_example_list()?),
+            )),
+        }
+    }
+
+    /// The worked examples' text and where it came from (see [`crate::v2::examples`]).
+    #[must_use]
+    pub fn worked_examples(&self) -> (&str, &str) {
+        self.templates
+            .get(WORKED_EXAMPLES)
+            .map_or(("", "none"), |(s, o)| (s.as_str(), o.as_str()))
+    }
+
+    /// The one-call answer's system message: `v2_system` with the step functions
+    /// (generated from the registry), then `scene` (a summary of the map), so that the
+    /// whole message is the same for every instruction on one map.
+    ///
+    /// # Errors
+    /// [`PromptError::Template`].
+    pub fn v2_system(&self, scene: Option<&str>) -> Result<String, PromptError> {
+        let mut names = vec![planner_dsl::typed::PICK_FUNCTION];
+        names.extend_from_slice(planner_dsl::typed::STEP_FUNCTIONS);
+        let mut functions = String::new();
+        for f in names.iter().filter_map(|n| planner_dsl::lookup(n)) {
+            functions.push_str(&format!("# {}.\n{}\n", f.doc, f.signature()));
+        }
+        let sys = self.render(
+            "v2_system.md.j2",
+            minijinja::context! { functions => functions.trim_end() },
+        )?;
+        Ok(match scene {
+            Some(s) => format!("{sys}\nThe map here: {s}."),
+            None => sys,
+        })
+    }
+
+    /// The one-call request for `instruction` (with a summary of the conversation).
+    ///
+    /// # Errors
+    /// [`PromptError::Template`].
+    pub fn v2_request(
+        &self,
+        instruction: &str,
+        history: Option<&str>,
+    ) -> Result<ChatMessage, PromptError> {
+        Ok(ChatMessage::user(self.render(
+            "v2_request.md.j2",
+            minijinja::context! { instruction => instruction.trim(), history => history },
+        )?))
+    }
+
+    /// The targeted re-ask: what the checks found, in words the model can act on.
+    ///
+    /// # Errors
+    /// [`PromptError::Template`].
+    pub fn v2_reask(&self, findings: &[String]) -> Result<ChatMessage, PromptError> {
+        Ok(ChatMessage::user(self.render(
+            "v2_reask.md.j2",
+            minijinja::context! { findings => Value::from(Serde(findings)) },
+        )?))
     }
 
     /// The user message that sends errors back to the model.

@@ -111,6 +111,44 @@ impl Session {
         (p.len() >= 2).then(|| p[p.len() - 2])
     }
 
+    /// The conversation as named references for v2's request: where the session
+    /// started, then each visited instance, most recent last, with its id, e.g.
+    /// `start: [1.0, 1.0]; visited: table 17 (yellow) in turn 1, sofa 2 (black) in turn 2`.
+    #[must_use]
+    pub fn references(&self, map: &IvlMap) -> Option<String> {
+        if self.turns.is_empty() {
+            return None;
+        }
+        let p = self.start.position;
+        let mut visited = Vec::new();
+        for (k, t) in self.turns.iter().enumerate() {
+            for id in &t.visited {
+                if let Some(i) = map.instance_by_id(*id) {
+                    visited.push(format!(
+                        "{} {} ({}) in turn {}",
+                        i.label,
+                        i.id,
+                        i.colour.as_deref().unwrap_or("unknown colour"),
+                        k + 1
+                    ));
+                }
+            }
+        }
+        let last = self.turns.last().map(|t| t.end_pose).unwrap_or_default();
+        Some(format!(
+            "we started at [{:.1}, {:.1}]; you are at [{:.1}, {:.1}]; visited so far: {}",
+            p.x,
+            p.y,
+            last[0],
+            last[1],
+            if visited.is_empty() {
+                "nothing".to_string()
+            } else {
+                visited.join(", ")
+            }
+        ))
+    }
+
     /// A compact summary of the recent turns for the prompt, e.g.
     /// `"go to the red sofa" -> stopped at sofa (red, instance 2) at (3.1, 4.0)`.
     #[must_use]
@@ -198,6 +236,23 @@ impl Session {
         ctx: &PlanContext<'_>,
     ) -> Result<Outcome, LanguageError> {
         let t0 = Instant::now();
+        if ctx.options.pipeline == crate::Pipeline::V2 {
+            // v2: no word lists; the history reaches the model as named references
+            // (what was visited, where the session started) and resolves through the
+            // typed plan it writes.
+            let mut ctx = ctx.clone();
+            if ctx.history.is_none() {
+                ctx.history = self.references(ctx.map);
+            }
+            for t in &self.turns {
+                for id in &t.visited {
+                    if !ctx.references.contains(id) {
+                        ctx.references.push(*id);
+                    }
+                }
+            }
+            return plan_instruction(backend, prompts, instruction, &ctx);
+        }
         if is_go_back(instruction) {
             let Some(p) = self.previous_stop() else {
                 return Ok(Outcome::Question(

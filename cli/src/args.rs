@@ -182,6 +182,26 @@ pub(crate) struct ModelArgs {
     /// reconciliation with the instruction's words (measures the model alone).
     #[arg(long)]
     pub(crate) raw_tuples: bool,
+    /// Language layer: v1 (two steps, word tables, repairs) or v2 (one constrained
+    /// call per instruction, typed checks, one re-ask, then a question).
+    #[arg(long, value_enum, default_value_t = PipelineArg::V1)]
+    pub(crate) pipeline: PipelineArg,
+    /// v2: worked examples shown per instruction (the most similar to it).
+    #[arg(long, default_value_t = 3)]
+    pub(crate) examples: usize,
+    /// v2, llama: hold the answer with llama.cpp's GBNF sampler instead of llguidance
+    /// (slower; for comparison).
+    #[arg(long)]
+    pub(crate) gbnf: bool,
+}
+
+/// `--pipeline`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum PipelineArg {
+    /// Two steps with word tables and repairs.
+    V1,
+    /// One constrained call per instruction.
+    V2,
 }
 
 /// Which steps decode under a GBNF grammar.
@@ -215,6 +235,13 @@ impl ModelArgs {
             script_grammar: matches!(self.grammar, Grammar::Script | Grammar::Both),
             tuple_check: !self.raw_tuples,
             reconcile: !self.raw_tuples,
+            pipeline: match self.pipeline {
+                PipelineArg::V1 => agent::Pipeline::V1,
+                PipelineArg::V2 => agent::Pipeline::V2,
+            },
+            examples: self.examples,
+            llguidance: !self.gbnf,
+            answer_grammar: !matches!(self.grammar, Grammar::None),
             ..PlanOptions::default()
         }
     }

@@ -36,14 +36,20 @@ pub(crate) fn eval(
 ) -> Result<ExitCode, CliError> {
     let kind = SuiteKind::from_path(suite).map_err(CliError::input)?;
     let variants: Vec<(String, Prompts)> = if prompt_dirs.is_empty() {
-        vec![("builtin".into(), Prompts::builtin())]
+        vec![(
+            "builtin".into(),
+            crate::retrieval::with_retrieval(Prompts::builtin(), plan_options),
+        )]
     } else {
         prompt_dirs
             .iter()
             .map(|d| {
                 Ok((
                     d.display().to_string(),
-                    Prompts::load(d).map_err(CliError::input)?,
+                    crate::retrieval::with_retrieval(
+                        Prompts::load(d).map_err(CliError::input)?,
+                        plan_options,
+                    ),
                 ))
             })
             .collect::<Result<_, CliError>>()?
@@ -53,7 +59,7 @@ pub(crate) fn eval(
         Some(Baseline::Vlmap) => Method::Vlmap,
         Some(Baseline::Reference) => Method::Reference,
     };
-    if kind == SuiteKind::Extract && baseline.is_some() {
+    if kind != SuiteKind::Nav && baseline.is_some() {
         return Err(CliError::Input(
             "--baseline applies to navigation suites (.nav.jsonl) only".into(),
         ));
@@ -62,14 +68,24 @@ pub(crate) fn eval(
         || suite.display().to_string(),
         |n| n.to_string_lossy().to_string(),
     );
-    let (extract_cases, nav_tasks) = match kind {
+    let (extract_cases, nav_tasks, dialogues) = match kind {
         SuiteKind::Extract => (
             load_extract_suite(suite).map_err(CliError::input)?,
             Vec::new(),
+            Vec::new(),
         ),
-        SuiteKind::Nav => (Vec::new(), load_nav_suite(suite).map_err(CliError::input)?),
+        SuiteKind::Nav => (
+            Vec::new(),
+            load_nav_suite(suite).map_err(CliError::input)?,
+            Vec::new(),
+        ),
+        SuiteKind::Chat => (
+            Vec::new(),
+            Vec::new(),
+            eval::suite::load_chat_suite(suite).map_err(CliError::input)?,
+        ),
     };
-    let n = extract_cases.len() + nav_tasks.len();
+    let n = extract_cases.len() + nav_tasks.len() + dialogues.len();
     let mut reports = Vec::new();
     // The reference method needs no model: one run, no backend.
     let backend_runs: Vec<Option<&BackendChoice>> = if method == Method::Reference {
@@ -97,6 +113,16 @@ pub(crate) fn eval(
                     Some(b) => {
                         run_extract(&extract_cases, b.as_ref(), prompts, plan_options, &mut tick)
                     }
+                    None => Vec::new(),
+                },
+                SuiteKind::Chat => match &backend {
+                    Some(b) => eval::chat::run_chat(
+                        &dialogues,
+                        b.as_ref(),
+                        prompts,
+                        plan_options,
+                        &mut tick,
+                    ),
                     None => Vec::new(),
                 },
                 SuiteKind::Nav => run_nav(

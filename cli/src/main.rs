@@ -14,6 +14,7 @@ mod mapbuild;
 mod mapinfo;
 mod mission;
 mod noise_cmd;
+mod retrieval;
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -93,7 +94,7 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             &scene,
             json,
             &backend.choice(),
-            &prompts(p.as_deref())?,
+            &retrieval::with_retrieval(prompts(p.as_deref())?, &backend.model_args.plan_options()),
             backend.model_args.plan_options(),
         ),
         Command::Eval {

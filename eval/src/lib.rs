@@ -3,12 +3,15 @@
 //!
 //! - [`suite::load_extract_suite`] / [`suite::load_nav_suite`]: read suites; errors name file, line, field.
 //! - [`run_extract`]: step 1 on each case, compared with `expected` ([`agent::tuples::same_tuples`]).
+//! - [`chat::run_chat`]: chat suites, turn by turn in one session; turn accuracy and
+//!   dialogue success.
 //! - [`run_nav`]: each task planned by a [`Method`] and executed on a simulated robot from
 //!   the task's start pose; [`score::reached`] scores the stops; [`Report`] holds T_1..T_K and SR.
 
 #![warn(missing_docs)]
 
 pub mod baseline;
+pub mod chat;
 pub mod noise;
 pub mod report;
 pub mod score;
@@ -80,6 +83,7 @@ pub fn run_extract(
                     instruction: Some(c.instruction.clone()),
                     trajectory: None,
                     reached: None,
+                    turns: None,
                 },
                 Err(e) => CaseResult {
                     id: c.id.clone(),
@@ -90,6 +94,7 @@ pub fn run_extract(
                     instruction: Some(c.instruction.clone()),
                     trajectory: None,
                     reached: None,
+                    turns: None,
                 },
             };
             on_case(&res);
@@ -228,6 +233,7 @@ pub fn run_task(
         instruction: Some(task.instruction.clone()),
         trajectory: Some(trajectory),
         reached: Some(reached),
+        turns: None,
     }
 }
 

@@ -31,6 +31,9 @@ pub struct CaseResult {
     /// Navigation: per subgoal, whether it was reached.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reached: Option<Vec<bool>>,
+    /// Chat: one result per turn, in order.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turns: Option<Vec<crate::chat::TurnResult>>,
 }
 
 /// The report's summary.
@@ -52,6 +55,12 @@ pub struct Summary {
     /// Navigation: share of subgoals reached.
     #[serde(rename = "SR", default, skip_serializing_if = "Option::is_none")]
     pub sr: Option<f64>,
+    /// Chat: share of turns whose every subgoal was reached.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turn_accuracy: Option<f64>,
+    /// Chat: share of dialogues whose every turn was.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dialogue_success: Option<f64>,
 }
 
 /// The report file of formats.md.
@@ -139,6 +148,12 @@ pub fn summarise(cases: &[CaseResult]) -> Summary {
     let ok = cases.iter().filter(|c| c.ok).count();
     let reached: Vec<Vec<bool>> = cases.iter().filter_map(|c| c.reached.clone()).collect();
     let nav = (!reached.is_empty()).then(|| nav_scores(&reached));
+    let turns: Vec<&crate::chat::TurnResult> = cases
+        .iter()
+        .filter_map(|c| c.turns.as_ref())
+        .flatten()
+        .collect();
+    let chat = (!turns.is_empty()).then(|| (turns.iter().filter(|t| t.ok()).count(), turns.len()));
     Summary {
         total: cases.len(),
         ok,
@@ -147,6 +162,8 @@ pub fn summarise(cases: &[CaseResult]) -> Summary {
         latency_ms_p95: percentile(&lat, 95.0),
         t: nav.as_ref().map(|n| n.t.clone()),
         sr: nav.map(|n| n.sr),
+        turn_accuracy: chat.map(|(ok, n)| ratio(ok, n)),
+        dialogue_success: chat.map(|_| ratio(ok, cases.len())),
     }
 }
 
@@ -210,6 +227,23 @@ pub fn summary_table(reports: &[Report]) -> String {
                 .collect(),
         ));
     }
+    for (name, get) in [
+        (
+            "turn accuracy",
+            (|r: &Report| r.summary.turn_accuracy) as fn(&Report) -> Option<f64>,
+        ),
+        ("dialogue success", |r: &Report| r.summary.dialogue_success),
+    ] {
+        if reports.iter().any(|r| get(r).is_some()) {
+            rows.push((
+                name.into(),
+                reports
+                    .iter()
+                    .map(|r| get(r).map_or("-".into(), |v| format!("{v:.3}")))
+                    .collect(),
+            ));
+        }
+    }
     rows.push((
         "latency p50 ms".into(),
         reports
@@ -264,6 +298,7 @@ mod tests {
             instruction: None,
             trajectory: None,
             reached,
+            turns: None,
         }
     }
 

@@ -20,6 +20,8 @@ pub enum SuiteKind {
     Extract,
     /// `*.nav.jsonl`: multi-subgoal navigation tasks on a scene.
     Nav,
+    /// `*.chat.jsonl`: dialogues, turns in one session.
+    Chat,
 }
 
 impl SuiteKind {
@@ -36,6 +38,8 @@ impl SuiteKind {
             Ok(SuiteKind::Extract)
         } else if name.ends_with(".nav.jsonl") {
             Ok(SuiteKind::Nav)
+        } else if name.ends_with(".chat.jsonl") {
+            Ok(SuiteKind::Chat)
         } else {
             Err(SuiteError::UnknownKind {
                 file: path.to_path_buf(),
@@ -57,7 +61,7 @@ pub enum SuiteError {
         source: std::io::Error,
     },
     /// The name does not say which kind of suite it is.
-    #[error("{}: cannot tell the suite kind: the file name must end in .extract.jsonl or .nav.jsonl", file.display())]
+    #[error("{}: cannot tell the suite kind: the file name must end in .extract.jsonl, .nav.jsonl or .chat.jsonl", file.display())]
     UnknownKind {
         /// The suite file.
         file: PathBuf,
@@ -198,28 +202,7 @@ pub fn load_nav_suite(path: &Path) -> Result<Vec<NavTask>, SuiteError> {
     for (line, obj) in json_lines(path)? {
         let at = At { file: path, line };
         let id = at.id(&obj, &mut ids)?;
-        let scene_rel = at.string(&obj, "scene")?;
-        let scene_path = dir.join(&scene_rel);
-        let map = match maps.get(&scene_path) {
-            Some(m) => m.clone(),
-            None => {
-                let scene = Scene::from_path(&scene_path).map_err(|e| SuiteError::Scene {
-                    file: path.to_path_buf(),
-                    line,
-                    source: Box::new(e),
-                })?;
-                let m = Arc::new(IvlMap::from_scene(&scene));
-                maps.insert(scene_path.clone(), m.clone());
-                m
-            }
-        };
-        let start = match obj.get("start") {
-            None | Some(Value::Null) => map.start_pose,
-            Some(v) => {
-                let a = at.numbers(v, "start", 3)?;
-                Pose::new(a[0], a[1], a[2])
-            }
-        };
+        let (scene_path, map, start) = at.scene_and_start(&obj, &dir, &mut maps)?;
         let instruction = at.string(&obj, "instruction")?;
         let subgoals =
             match obj.get("subgoals") {
@@ -254,6 +237,128 @@ pub fn load_nav_suite(path: &Path) -> Result<Vec<NavTask>, SuiteError> {
         });
     }
     Ok(tasks)
+}
+
+/// One turn of a dialogue.
+#[derive(Debug, Clone)]
+pub struct ChatTurn {
+    /// What the person says.
+    pub say: String,
+    /// Where this turn must stop (scored on this turn's stops).
+    pub subgoals: Vec<Subgoal>,
+    /// `"expect": "question"`: the product should ask instead of moving.
+    pub expect_question: bool,
+}
+
+/// One dialogue of a chat suite.
+#[derive(Debug, Clone)]
+pub struct Dialogue {
+    /// Case id.
+    pub id: String,
+    /// The scene file (resolved against the suite's folder).
+    pub scene_path: PathBuf,
+    /// The map built from it (shared between dialogues on one scene).
+    pub map: Arc<IvlMap>,
+    /// Where the robot starts.
+    pub start: Pose,
+    /// The turns, in order.
+    pub turns: Vec<ChatTurn>,
+    /// 1-based line in the suite file.
+    pub line: usize,
+}
+
+/// Reads a chat suite (formats.md, "Chat suite"), loading each scene once and checking
+/// every subgoal against it.
+///
+/// # Errors
+/// [`SuiteError`] naming the file, line and field (`turns[1].subgoals[0].object`).
+pub fn load_chat_suite(path: &Path) -> Result<Vec<Dialogue>, SuiteError> {
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut maps: HashMap<PathBuf, Arc<IvlMap>> = HashMap::new();
+    let mut ids = HashSet::new();
+    let mut out = Vec::new();
+    for (line, obj) in json_lines(path)? {
+        let at = At { file: path, line };
+        let id = at.id(&obj, &mut ids)?;
+        let (scene_path, map, start) = at.scene_and_start(&obj, &dir, &mut maps)?;
+        let items = match obj.get("turns") {
+            Some(Value::Array(items)) if !items.is_empty() => items,
+            Some(Value::Array(_)) => {
+                return Err(at.field("turns", "is empty: list at least one turn"))
+            }
+            Some(v) => {
+                return Err(at.field(
+                    "turns",
+                    format!(
+                        "must be a list of {{\"say\", \"subgoals\"}}, found {}",
+                        kind_of(v)
+                    ),
+                ))
+            }
+            None => return Err(at.field("turns", "is missing")),
+        };
+        let mut turns = Vec::new();
+        for (i, t) in items.iter().enumerate() {
+            let f = format!("turns[{i}]");
+            let Some(t) = t.as_object() else {
+                return Err(at.field(&f, format!("must be an object, found {}", kind_of(t))));
+            };
+            let say = at
+                .string(t, "say")
+                .map_err(|_| at.field(&format!("{f}.say"), "must be a non-empty string"))?;
+            let expect_question = match t.get("expect") {
+                None | Some(Value::Null) => false,
+                Some(Value::String(s)) if s == "question" => true,
+                Some(v) => {
+                    return Err(at.field(
+                        &format!("{f}.expect"),
+                        format!("the only expectation is \"question\", found {v}"),
+                    ))
+                }
+            };
+            let subgoals = match t.get("subgoals") {
+                Some(Value::Array(gs)) => gs
+                    .iter()
+                    .enumerate()
+                    .map(|(j, v)| {
+                        at.subgoal(v, j, &map).map_err(|e| match e {
+                            SuiteError::Field { field, message, .. } => {
+                                at.field(&format!("{f}.{field}"), message)
+                            }
+                            other => other,
+                        })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?,
+                Some(v) => {
+                    return Err(at.field(
+                        &format!("{f}.subgoals"),
+                        format!("must be a list, found {}", kind_of(v)),
+                    ))
+                }
+                None => return Err(at.field(&format!("{f}.subgoals"), "is missing")),
+            };
+            if subgoals.is_empty() && !expect_question {
+                return Err(at.field(
+                    &format!("{f}.subgoals"),
+                    "is empty: list where the turn must stop, or say \"expect\": \"question\"",
+                ));
+            }
+            turns.push(ChatTurn {
+                say,
+                subgoals,
+                expect_question,
+            });
+        }
+        out.push(Dialogue {
+            id,
+            scene_path,
+            map,
+            start,
+            turns,
+            line,
+        });
+    }
+    Ok(out)
 }
 
 /// Non-blank lines of a JSONL file as JSON objects with their 1-based line numbers.
@@ -330,6 +435,39 @@ impl At<'_> {
             Some(v) => Err(self.field(key, format!("must be a string, found {}", kind_of(v)))),
             None => Err(self.field(key, "is missing")),
         }
+    }
+
+    /// The `scene` (loaded once per path into `maps`) and the `start` pose (the scene's
+    /// start pose when absent).
+    fn scene_and_start(
+        &self,
+        obj: &Obj,
+        dir: &Path,
+        maps: &mut HashMap<PathBuf, Arc<IvlMap>>,
+    ) -> Result<(PathBuf, Arc<IvlMap>, Pose), SuiteError> {
+        let scene_rel = self.string(obj, "scene")?;
+        let scene_path = dir.join(&scene_rel);
+        let map = match maps.get(&scene_path) {
+            Some(m) => m.clone(),
+            None => {
+                let scene = Scene::from_path(&scene_path).map_err(|e| SuiteError::Scene {
+                    file: self.file.to_path_buf(),
+                    line: self.line,
+                    source: Box::new(e),
+                })?;
+                let m = Arc::new(IvlMap::from_scene(&scene));
+                maps.insert(scene_path.clone(), m.clone());
+                m
+            }
+        };
+        let start = match obj.get("start") {
+            None | Some(Value::Null) => map.start_pose,
+            Some(v) => {
+                let a = self.numbers(v, "start", 3)?;
+                Pose::new(a[0], a[1], a[2])
+            }
+        };
+        Ok((scene_path, map, start))
     }
 
     fn id(&self, obj: &Obj, seen: &mut HashSet<String>) -> Result<String, SuiteError> {

@@ -115,6 +115,12 @@ pub struct CompletionRequest {
     /// and otherwise ignores it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grammar: Option<String>,
+    /// A Lark grammar (llguidance's syntax, start rule `start`) the output must follow.
+    /// The llama backend prefers it to `grammar` (llguidance computes each token mask in
+    /// microseconds where GBNF takes milliseconds); other backends ignore it, so send a
+    /// `grammar` too where they should be held.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lark: Option<String>,
     /// A JSON schema the output should follow. The openai backend sends it as
     /// `response_format` when configured to; the llama backend converts it to a grammar
     /// when no `grammar` is given.
@@ -132,6 +138,7 @@ impl CompletionRequest {
             temperature: 0.0,
             stop: Vec::new(),
             grammar: None,
+            lark: None,
             json_schema: None,
         }
     }

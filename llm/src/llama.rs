@@ -397,6 +397,7 @@ fn worker_main(cfg: LlamaCppConfig, ready: SyncSender<Result<(), LlmError>>, rx:
         slots: (0..n_slots).map(|_| Slot::default()).collect(),
         clock: 0,
         cfg: &cfg,
+        llg: None,
     };
     if ready.send(Ok(())).is_err() {
         return;
@@ -431,6 +432,9 @@ struct Worker<'m> {
     /// Counts requests, for least-recently-used choices.
     clock: u64,
     cfg: &'m LlamaCppConfig,
+    /// llguidance's grammar compiler for this model's vocabulary, built on the first
+    /// request with a Lark grammar (walking the vocabulary once).
+    llg: Option<llguidance::ParserFactory>,
 }
 
 /// The slot for a prompt and the length of the prefix it already holds: the slot with the
@@ -467,9 +471,50 @@ fn choose_slot(slots: &[Slot], tokens: &[LlamaToken]) -> (usize, usize) {
     }
 }
 
+/// The sampler chain of a request, and for a Lark grammar a second matcher that follows
+/// the sampled tokens to find the tokens the grammar forces (fast-forward).
+struct Sampling {
+    chain: LlamaSampler,
+    shadow: Option<llguidance::Matcher>,
+}
+
 impl Worker<'_> {
-    fn sampler(&self, req: &CompletionRequest) -> Result<LlamaSampler, LlmError> {
+    fn lark_matcher(&mut self, lark: &str) -> Result<llguidance::Matcher, LlmError> {
+        let bad = |what: &str, e: String| LlmError::Grammar {
+            message: format!("llguidance {what}: {e}"),
+        };
+        if self.llg.is_none() {
+            let env = LlamaSampler::llguidance_tok_env(self.model);
+            self.llg = Some(
+                llguidance::ParserFactory::new_simple(&env)
+                    .map_err(|e| bad("cannot read this model's vocabulary", e.to_string()))?,
+            );
+        }
+        let factory = self
+            .llg
+            .as_ref()
+            .ok_or_else(|| bad("is not ready", String::new()))?;
+        let grammar = llguidance::api::TopLevelGrammar::from_lark(lark.to_string());
+        let parser = factory
+            .create_parser(grammar)
+            .map_err(|e| bad("rejected the Lark grammar", e.to_string()))?;
+        let m = llguidance::Matcher::new(Ok(parser));
+        match m.get_error() {
+            Some(e) => Err(bad("rejected the Lark grammar", e)),
+            None => Ok(m),
+        }
+    }
+
+    fn sampler(&mut self, req: &CompletionRequest) -> Result<Sampling, LlmError> {
+        let mut chain = Vec::new();
+        let mut shadow = None;
+        if let Some(lark) = &req.lark {
+            let m = self.lark_matcher(lark)?;
+            shadow = Some(m.deep_clone());
+            chain.push(LlamaSampler::from(m));
+        }
         let grammar = match (&req.grammar, &req.json_schema) {
+            _ if shadow.is_some() => None,
             (Some(g), _) => Some(g.clone()),
             (None, Some(schema)) => Some(
                 llama_cpp_2::json_schema_to_grammar(&schema.to_string()).map_err(|e| {
@@ -480,7 +525,6 @@ impl Worker<'_> {
             ),
             (None, None) => None,
         };
-        let mut chain = Vec::new();
         if let Some(g) = grammar {
             let s =
                 LlamaSampler::grammar(self.model, &g, "root").map_err(|e| LlmError::Grammar {
@@ -499,7 +543,10 @@ impl Worker<'_> {
             chain.push(LlamaSampler::temp(req.temperature));
             chain.push(LlamaSampler::dist(self.cfg.seed));
         }
-        Ok(LlamaSampler::chain_simple(chain))
+        Ok(Sampling {
+            chain: LlamaSampler::chain_simple(chain),
+            shadow,
+        })
     }
 
     fn reset_cache(&mut self) {
@@ -554,7 +601,10 @@ impl Worker<'_> {
             });
         }
         // Build the sampler first: a bad grammar fails before the cache is touched.
-        let mut sampler = self.sampler(req)?;
+        let Sampling {
+            chain: mut sampler,
+            mut shadow,
+        } = self.sampler(req)?;
 
         let max_new = (req.max_tokens as usize).min(n_ctx - tokens.len());
 
@@ -658,14 +708,47 @@ impl Worker<'_> {
             if n_gen >= max_new {
                 break FinishReason::Length;
             }
+            // Fast-forward: the tokens the grammar forces after this one are not sampled
+            // one by one; they join this token in one batch.
+            let mut forced = Vec::new();
+            if let Some(m) = shadow.as_mut() {
+                if m.consume_token(tok.0.cast_unsigned()).is_ok() {
+                    let room = (max_new - n_gen).min(n_batch.saturating_sub(1));
+                    forced = m.compute_ff_tokens();
+                    forced.truncate(room);
+                    if !forced.is_empty() && m.consume_tokens(&forced).is_err() {
+                        forced.clear();
+                    }
+                }
+            }
             batch.clear();
-            add(&mut batch, tok, pos, seq, true)?;
+            let step: Vec<LlamaToken> = std::iter::once(tok)
+                .chain(forced.iter().map(|t| LlamaToken(t.cast_signed())))
+                .collect();
+            for (j, &t) in step.iter().enumerate() {
+                add(&mut batch, t, pos + j, seq, j + 1 == step.len())?;
+            }
             self.decode(&mut batch)?;
             if let Some(s) = self.slots.get_mut(slot) {
-                s.tokens.push(tok);
+                s.tokens.extend_from_slice(&step);
             }
-            pos += 1;
-            last_idx = 0;
+            pos += step.len();
+            last_idx = batch.n_tokens() - 1;
+            let mut stopped = false;
+            for &t in &step[1..] {
+                sampler.accept(t);
+                n_gen += 1;
+                let before = out.len();
+                out.extend_from_slice(&vocab.token_to_piece(t, false, None));
+                if let Some(cut) = find_stop(&out, before, max_stop, &req.stop) {
+                    out.truncate(cut);
+                    stopped = true;
+                    break;
+                }
+            }
+            if stopped {
+                break FinishReason::Stop;
+            }
         };
         let generate_ms = t_gen.elapsed().as_secs_f64() * 1e3;
         Ok(Completion {

@@ -186,6 +186,28 @@ pub fn plural(phrase: &str) -> String {
     format!("{head}{p}")
 }
 
+/// The other words of `name`'s synonym group (not `name` itself), e.g. "couch" and
+/// "settee" for "sofa"; empty when the table knows none.
+///
+/// ```
+/// assert_eq!(map_core::matcher::synonyms("sofa"), ["couch", "settee"]);
+/// assert!(map_core::matcher::synonyms("chair").is_empty());
+/// ```
+#[must_use]
+pub fn synonyms(name: &str) -> Vec<&'static str> {
+    let c = canonical(name);
+    SYNONYMS
+        .iter()
+        .find(|g| g[0] == c)
+        .map(|g| {
+            g.iter()
+                .copied()
+                .filter(|w| *w != normalise(name))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
 /// The canonical form of a name: normalised, singular, synonym group head.
 pub fn canonical(s: &str) -> String {
     let n = normalise(s);

@@ -118,10 +118,13 @@ impl fmt::Display for ObjectOrder {
     }
 }
 
-/// "1st", "2nd", "3rd", "11th", "last".
+/// "1st", "2nd", "3rd", "11th", "last", "2nd to last" (k = -2).
 pub fn ordinal_word(k: i64) -> String {
     if k == -1 {
         return "last".into();
+    }
+    if k < -1 {
+        return format!("{} to last", ordinal_word(-k));
     }
     let suffix = match (k % 10, k % 100) {
         (_, 11..=13) => "th",
@@ -174,7 +177,8 @@ pub enum QueryError {
         /// The ordinal asked for.
         k: i64,
     },
-    /// `k` is below -1.
+    /// An ordinal that cannot count anything (kept for callers that match on it; the
+    /// selection itself reads every integer: k >= 1 from the front, -n from the back).
     #[error(
         "ordinal {k} is not valid: use k >= 1 for the k-th, 0 for the nearest, -1 for the last"
     )]
@@ -273,7 +277,8 @@ impl IvlMap {
     ///
     /// Picks among instances whose label matches `name` and (if `colour` is given and
     /// not empty) whose colour matches it. `k == 0` = the first in the order
-    /// (by default the nearest), `k >= 1` = the k-th, `k == -1` = the last.
+    /// (by default the nearest), `k >= 1` = the k-th, `k == -1` = the last, `k == -n` the
+    /// n-th from the end (-2 = the second to last).
     pub fn get_obj_attributes(
         &self,
         name: &str,
@@ -500,10 +505,10 @@ mod tests {
             .get_obj_attributes("sofa", 2, None, ObjectOrder::NearToFar, AT_ORIGIN)
             .unwrap_err();
         assert_eq!(e.to_string(), "there is 1 sofa; asked for the 2nd");
-        assert!(matches!(
-            m.get_obj_attributes("sofa", -3, None, ObjectOrder::NearToFar, AT_ORIGIN),
-            Err(QueryError::BadOrdinal { k: -3 })
-        ));
+        let e = m
+            .get_obj_attributes("sofa", -3, None, ObjectOrder::NearToFar, AT_ORIGIN)
+            .unwrap_err();
+        assert_eq!(e.to_string(), "there is 1 sofa; asked for the 3rd to last");
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //! |---|---|
 //! | "the 3rd chair", "chair number 3", "table three" | `ordinal: 3` |
 //! | "the last chair", "the farthest chair", "the chair furthest from you" | `ordinal: -1` (near_to_far) |
-//! | "the second to last chair", "the penultimate chair" | `ordinal: 2`, the reversed order (`far_to_near`) |
+//! | "the second to last chair", "the penultimate chair" | `ordinal: 2`, the reversed order (`far_to_near`), or `ordinal: -2` (n-th from the end) |
 //! | "the red sofa", "the sofa, the red one", "a red sofa" | `colour: "red"` |
 //! | "the table that isn't yellow" | `not_colour: "yellow"` |
 //! | "the plant in the lounge" | `region: "lounge"` |
@@ -193,14 +193,16 @@ impl IvlMap {
         robot: Pose,
     ) -> Result<&Instance, QueryError> {
         let k = sel.ordinal;
-        if k < -1 {
-            return Err(QueryError::BadOrdinal { k });
-        }
         let (label, cands) = self.candidates_with(matcher, sel, robot)?;
+        // k >= 1 counts from the front, -n from the back (-1 the last, -2 the second to
+        // last), 0 is the first (the nearest by default).
         let idx = match k {
-            -1 => cands.len() - 1,
             0 => 0,
-            k => usize::try_from(k - 1).unwrap_or(usize::MAX),
+            k if k > 0 => usize::try_from(k - 1).unwrap_or(usize::MAX),
+            k => usize::try_from(k.unsigned_abs())
+                .ok()
+                .and_then(|n| cands.len().checked_sub(n))
+                .unwrap_or(usize::MAX),
         };
         cands.get(idx).copied().ok_or_else(|| {
             let noun = if cands.len() == 1 {
@@ -421,6 +423,16 @@ mod tests {
         east.order = west.order.reversed();
         assert_eq!(pick(&m, &east), 3);
         assert_eq!(ObjectOrder::EastToWest.reversed(), ObjectOrder::WestToEast);
+        // -n counts from the end of the order itself: -2 is the same instance.
+        assert_eq!(pick(&m, &Selection::new("table").nth(-2)), 3);
+        assert_eq!(pick(&m, &west.clone().nth(-2)), 3);
+        let past = m
+            .select(&Selection::new("table").nth(-9), ORIGIN)
+            .unwrap_err();
+        assert!(
+            past.to_string().ends_with("asked for the 9th to last"),
+            "{past}"
+        );
         for (o, _) in ObjectOrder::ALL {
             assert_eq!(o.reversed().reversed(), o);
             assert_ne!(o.reversed(), o);

@@ -254,6 +254,16 @@ impl<'a> Host<'a> {
                     .map_err(map_err)?;
                 value(Dynamic::from(record(inst)))
             }
+            "get_instance" => {
+                let k = self.ordinal_arg(spec, 0, &args[0])?;
+                let inst = u32::try_from(k)
+                    .ok()
+                    .and_then(|id| self.map.instance_by_id(id))
+                    .ok_or_else(|| {
+                        arg_err(spec, 0, format!("{k}: no object on this map has that id"))
+                    })?;
+                value(Dynamic::from(record(inst)))
+            }
             "get_obj" => {
                 let sel = self.selection_args(spec, args)?;
                 let inst = self.map.select(&sel, pose).map_err(map_err)?;
@@ -600,11 +610,11 @@ impl<'a> Host<'a> {
                 ),
             ));
         };
-        if !(-1..=MAX_ORDINAL).contains(&k) {
+        if !(-MAX_ORDINAL..=MAX_ORDINAL).contains(&k) {
             return Err(arg_err(
                 spec,
                 idx,
-                format!("of {} is out of range: use k >= 1 for the k-th, 0 for the nearest, -1 for the last", num(k as f64)),
+                format!("of {} is out of range: use k >= 1 for the k-th, -1 for the last, -2 for the second to last, 0 for the nearest", num(k as f64)),
             ));
         }
         Ok(k)

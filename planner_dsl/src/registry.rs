@@ -31,6 +31,8 @@ pub enum ParamType {
     Angle,
     /// Free text.
     Text,
+    /// The id of an object on the map (as the conversation names the objects it visited).
+    Id,
     /// What else the person said about the object, as a map with any of the keys
     /// `ordinal`, `colour`, `not_colour`, `order`, `region` and `near` (another object):
     /// `#{ordinal: 2, near: table}`.
@@ -43,13 +45,14 @@ impl ParamType {
         match self {
             ParamType::Object => "object record or name",
             ParamType::Name => "string",
-            ParamType::Ordinal => "integer (k >= 1, -1 = last, 0 = nearest)",
+            ParamType::Ordinal => "integer (k >= 1, -1 = last, -2 = second to last, 0 = nearest)",
             ParamType::Colour => "colour word or \"\"",
             ParamType::Order => "order name",
             ParamType::Position => "[x, y] in metres",
             ParamType::Distance => "number (metres)",
             ParamType::Angle => "number (degrees)",
             ParamType::Text => "string",
+            ParamType::Id => "integer id of an object on the map",
             ParamType::Selection => {
                 "map #{ordinal, colour, not_colour, order, region, near}, every key optional"
             }
@@ -157,7 +160,7 @@ const REGION_ATTR_PARAMS: &[ParamSpec] = &[
     opt(
         "instance_idx",
         ParamType::Ordinal,
-        "k-th in the order among the objects in the region (1 = first), -1 = last, 0 = the nearest",
+        "k-th in the order among the objects in the region (1 = first), -1 = last, -2 = second to last, 0 = the nearest",
     ),
     opt(
         "object_color",
@@ -188,7 +191,7 @@ const ATTR_PARAMS: &[ParamSpec] = &[
     opt(
         "instance_idx",
         ParamType::Ordinal,
-        "k-th in the order (1 = first), -1 = last, 0 = unspecified (the nearest)",
+        "k-th in the order (1 = first), -1 = last, -2 = second to last, 0 = unspecified (the nearest)",
     ),
     opt(
         "object_color",
@@ -242,9 +245,15 @@ const SELECT_PARAMS: &[ParamSpec] = &[
     opt(
         "select",
         ParamType::Selection,
-        "ordinal: k-th (1 = first, -1 = last); colour; not_colour: a colour it must not have; order: what the ordinal counts in (default near_to_far; largest_to_smallest for \"the biggest\"); region: a room it is in; near: an object it is next to (distances then count from that object)",
+        "ordinal: k-th (1 = first, -1 = last, -2 = second to last); colour; not_colour: a colour it must not have; order: what the ordinal counts in (default near_to_far; largest_to_smallest for \"the biggest\"); region: a room it is in; near: an object it is next to (distances then count from that object)",
     ),
 ];
+
+const ID: &[ParamSpec] = &[req(
+    "id",
+    ParamType::Id,
+    "the id of an object visited earlier in the conversation",
+)];
 
 const fn f(
     name: &'static str,
@@ -295,6 +304,14 @@ static REGISTRY: &[FunctionSpec] = &[
         "object record (fields: name, colour, label_id, id, position)",
         "pick one object by everything said about it (\"the second chair next to the red table\", \"the sofa that isn't grey\", \"the biggest plant in the lounge\")",
         "let chair = agent.get_obj(\"chair\", #{ordinal: 2, near: agent.get_obj(\"table\", #{colour: \"red\"})});",
+        false,
+    ),
+    f(
+        "get_instance",
+        ID,
+        "object record (fields: name, colour, label_id, id, position)",
+        "the object with this id: one visited earlier in the conversation (\"the table you just visited\", \"the same chair again\")",
+        "let table = agent.get_instance(17);",
         false,
     ),
     f(
@@ -654,7 +671,7 @@ mod tests {
         ] {
             assert!(lookup(name).is_some(), "{name} missing");
         }
-        assert_eq!(registry().len(), 26); // the paper's 21 (two spellings) + say, get_obj_in_region, get_obj, move_between_the_two, move_to_start
+        assert_eq!(registry().len(), 27); // the paper's 21 (two spellings) + say, get_obj_in_region, get_obj, get_instance, move_between_the_two, move_to_start
     }
 
     #[test]

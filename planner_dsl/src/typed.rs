@@ -43,6 +43,8 @@ pub enum Object {
     Name(String),
     /// A variable bound by an earlier [`Step::Let`].
     Var(String),
+    /// `get_instance(id)`: an object by its id (one the conversation visited).
+    Instance(u32),
 }
 
 /// The side functions: a move to one side of an object, or a turn putting it on one side.
@@ -132,6 +134,33 @@ pub enum Step {
     /// `say(text)`.
     Say(String),
 }
+
+/// The library functions a typed step calls (the grammar of the one-call answer offers
+/// exactly these, with their registry signatures), and the pick function whose
+/// canonical form every target prints as.
+pub const STEP_FUNCTIONS: &[&str] = &[
+    "move_to_object",
+    "move_to_left",
+    "move_to_right",
+    "move_north",
+    "move_south",
+    "move_east",
+    "move_west",
+    "with_object_on_left",
+    "with_object_on_right",
+    "move_in_between",
+    "move_between_the_two",
+    "face",
+    "turn",
+    "turn_absolute",
+    "move_forward",
+    "move_to",
+    "move_to_start",
+    "say",
+];
+
+/// The pick function of [`Object::Pick`]'s canonical form.
+pub const PICK_FUNCTION: &str = "get_obj";
 
 /// A straight-line plan.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -287,6 +316,16 @@ impl Reader {
                 }
             }
             other => match call_of(other) {
+                Some((x, p)) if x.name.as_str() == "get_instance" => {
+                    let a: Vec<&Expr> = x.args.iter().collect();
+                    if a.len() != 1 {
+                        return Err(self.arg_err(p, "get_instance", "takes 1 argument"));
+                    }
+                    let k = self.int(Some(a[0]), "get_instance")?;
+                    u32::try_from(k).map(Object::Instance).map_err(|_| {
+                        self.arg_err(a[0].position(), "get_instance", "expected an object id")
+                    })
+                }
                 Some((x, p)) => Ok(Object::Pick(self.pick(x, p)?)),
                 None => Err(self.arg_err(other.position(), f, "expected an object")),
             },
@@ -503,6 +542,96 @@ impl Object {
             Object::Pick(t) => target_call(t, "get_obj"),
             Object::Name(n) => lit(n),
             Object::Var(v) => v.clone(),
+            Object::Instance(id) => format!("agent.get_instance({id})"),
+        }
+    }
+}
+
+impl Object {
+    /// Every selection inside this object expression, outermost first (a pick and,
+    /// recursively, its `near` anchor).
+    #[must_use]
+    pub fn targets(&self) -> Vec<&Target> {
+        let mut out = Vec::new();
+        let mut cur = self;
+        while let Object::Pick(t) = cur {
+            out.push(t);
+            match &t.near {
+                Some(o) => cur = o,
+                None => break,
+            }
+        }
+        out
+    }
+}
+
+impl Step {
+    /// The object expressions this step names (its targets, bindings included), in
+    /// argument order.
+    #[must_use]
+    pub fn targets(&self) -> Vec<&Target> {
+        match self {
+            Step::Let { target, .. } | Step::BetweenTwo(target) => {
+                let mut v = vec![target];
+                if let Some(o) = &target.near {
+                    v.extend(o.targets());
+                }
+                v
+            }
+            Step::GoTo(o) | Step::Face(o) | Step::Side { object: o, .. } => o.targets(),
+            Step::Between(a, b) => {
+                let mut v = a.targets();
+                v.extend(b.targets());
+                v
+            }
+            Step::Turn(_)
+            | Step::TurnAbsolute(_)
+            | Step::Forward(_)
+            | Step::MoveTo(_)
+            | Step::ToStart
+            | Step::Say(_) => Vec::new(),
+        }
+    }
+
+    /// Whether the step ends in a stop (a goal-directed move).
+    #[must_use]
+    pub fn stops(&self) -> bool {
+        match self {
+            Step::GoTo(_)
+            | Step::Between(..)
+            | Step::BetweenTwo(_)
+            | Step::MoveTo(_)
+            | Step::ToStart => true,
+            Step::Side { side, .. } => !matches!(side, Side::OnLeft | Side::OnRight),
+            _ => false,
+        }
+    }
+
+    /// The objects this step acts on directly (not the anchors inside them).
+    #[must_use]
+    pub fn objects(&self) -> Vec<&Object> {
+        match self {
+            Step::GoTo(o) | Step::Face(o) | Step::Side { object: o, .. } => vec![o],
+            Step::Between(a, b) => vec![a, b],
+            _ => Vec::new(),
+        }
+    }
+
+    /// The bare names this step uses as objects (`move_to_object("kitchen")`).
+    #[must_use]
+    pub fn names(&self) -> Vec<&str> {
+        fn of(o: &Object) -> Option<&str> {
+            match o {
+                Object::Name(n) => Some(n.as_str()),
+                _ => None,
+            }
+        }
+        match self {
+            Step::GoTo(o) | Step::Face(o) | Step::Side { object: o, .. } => {
+                of(o).into_iter().collect()
+            }
+            Step::Between(a, b) => of(a).into_iter().chain(of(b)).collect(),
+            _ => Vec::new(),
         }
     }
 }

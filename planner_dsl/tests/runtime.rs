@@ -197,6 +197,7 @@ fn sample_arg((i, param): (usize, &planner_dsl::ParamSpec)) -> &'static str {
         ParamType::Distance => "0.5",
         ParamType::Angle => "30",
         ParamType::Text => "\"hello\"",
+        ParamType::Id => "1",
         ParamType::Selection => "#{ordinal: 1, near: \"sofa\"}",
     }
 }

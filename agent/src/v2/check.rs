@@ -1,0 +1,551 @@
+//! Checks of a one-call answer: they compare, they never rewrite.
+//!
+//! Three sources of disagreement, each a [`Finding`] with one message for the model (the
+//! targeted re-ask) and one for the person (the question asked when the re-ask does not
+//! settle it):
+//! - **words**: the instruction's colour, ordinal and superlative words against the typed
+//!   plan's targets ("third" said, no target with ordinal 3);
+//! - **the two parts**: the objects line against the plan (a tuple's object, colour or
+//!   ordinal that no target carries);
+//! - **the map**: an object the map does not hold, a colour no such object has, and the
+//!   dry run's first error.
+//!
+//! Nothing here edits the answer: the pipeline re-asks with the findings, then asks the
+//! person.
+
+use map_core::matcher::{canonical, is_colour_word};
+use map_core::{IvlMap, ObjectOrder, Pose, QueryError};
+use planner_dsl::typed::{Step, Target, TypedPlan};
+
+use crate::tuples::{normalise_colour, parse_ordinal, parse_ordinal_with_order, Tuple};
+use crate::words::words;
+
+/// What kind of disagreement a finding is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FindingKind {
+    /// The answer could not be read.
+    Unreadable,
+    /// A word of the instruction that no target reflects.
+    Word,
+    /// The objects line and the plan disagree.
+    Parts,
+    /// An object the map does not hold.
+    UnknownObject,
+    /// The map holds the object but not as asked (colour, count, exactly two).
+    NotOnMap,
+    /// The dry run failed.
+    Runtime,
+}
+
+/// One disagreement.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Finding {
+    /// Which kind.
+    pub kind: FindingKind,
+    /// For the re-ask: what to look at again.
+    pub to_model: String,
+    /// For the question: what is unclear, in the person's terms.
+    pub to_user: String,
+}
+
+impl Finding {
+    fn new(kind: FindingKind, to_model: impl Into<String>, to_user: impl Into<String>) -> Self {
+        Self {
+            kind,
+            to_model: to_model.into(),
+            to_user: to_user.into(),
+        }
+    }
+}
+
+/// Whether two colour words name the same colour ("grey" and "gray").
+fn same_colour(a: Option<&str>, b: &str) -> bool {
+    a.is_some_and(|a| canonical(a) == canonical(b))
+}
+
+/// The map label (or region name) a name means, if the map holds it.
+fn label_of(map: &IvlMap, name: &str, pose: Pose) -> Option<String> {
+    if let Ok(r) = map.find_region(name) {
+        return Some(r.name.clone());
+    }
+    map.get_obj_attributes(name, 0, None, ObjectOrder::default(), pose)
+        .ok()
+        .map(|i| i.label.clone())
+}
+
+/// The map label a word the person typed means, allowing a typo ("tabel", "chiar"): the
+/// exact reading first ([`label_of`]), else the one label or region within a small edit
+/// distance (1 for words up to 5 letters, 2 beyond), if exactly one is.
+fn label_of_typed(map: &IvlMap, name: &str, pose: Pose) -> Option<String> {
+    if let Some(l) = label_of(map, name, pose) {
+        return Some(l);
+    }
+    let n = map_core::matcher::singular(&map_core::matcher::normalise(name));
+    let limit = if n.chars().count() <= 5 { 1 } else { 2 };
+    let mut names: Vec<String> = map.label_counts().into_iter().map(|(l, _)| l).collect();
+    names.extend(map.regions.iter().map(|r| r.name.clone()));
+    let close: Vec<String> = names
+        .into_iter()
+        .filter(|l| strsim::damerau_levenshtein(&n, l) <= limit)
+        .collect();
+    match close.as_slice() {
+        [one] => Some(one.clone()),
+        _ => None,
+    }
+}
+
+/// Every target of the plan with the label it means.
+fn targets(plan: &TypedPlan) -> Vec<&Target> {
+    plan.steps.iter().flat_map(Step::targets).collect()
+}
+
+/// The labels the plan names, once per mention (targets and bare names).
+fn plan_labels(map: &IvlMap, plan: &TypedPlan, pose: Pose) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for t in targets(plan) {
+        out.extend(label_of(map, &t.name, pose));
+        out.extend(t.region.as_deref().and_then(|r| label_of(map, r, pose)));
+    }
+    for s in &plan.steps {
+        out.extend(s.names().into_iter().filter_map(|n| label_of(map, n, pose)));
+        for o in s.objects() {
+            if let planner_dsl::typed::Object::Instance(id) = o {
+                out.extend(map.instance_by_id(*id).map(|i| i.label.clone()));
+            }
+        }
+    }
+    out
+}
+
+/// A short list of what the map holds of `label`, for questions: "3 chairs (2 black, 1 red)".
+#[must_use]
+pub fn describe_label(map: &IvlMap, label: &str) -> String {
+    let of: Vec<_> = map.instances.iter().filter(|i| i.label == label).collect();
+    let mut colours: Vec<(String, usize)> = Vec::new();
+    for i in &of {
+        let c = i.colour.clone().unwrap_or_else(|| "unknown colour".into());
+        match colours.iter_mut().find(|(x, _)| *x == c) {
+            Some((_, k)) => *k += 1,
+            None => colours.push((c, 1)),
+        }
+    }
+    let noun = if of.len() == 1 {
+        label.to_string()
+    } else {
+        map_core::matcher::plural(label)
+    };
+    let cs: Vec<String> = colours.iter().map(|(c, k)| format!("{k} {c}")).collect();
+    format!("{} {noun} ({})", of.len(), cs.join(", "))
+}
+
+/// The labels the map holds, for a refusal.
+fn map_names(map: &IvlMap) -> String {
+    let mut v: Vec<String> = map.label_counts().into_iter().map(|(l, _)| l).collect();
+    v.extend(map.regions.iter().map(|r| r.name.clone()));
+    v.join(", ")
+}
+
+/// The objects line against the map and the plan: an object the person named (a word of
+/// the instruction) that the map lacks, a colour the map has no such object in, and an
+/// object the plan never goes to or uses. The line's ordinals and colours are the
+/// model's notes: the words check ([`check_words`]) compares the plan itself with what
+/// the person said.
+fn check_tuples(
+    map: &IvlMap,
+    instruction: &str,
+    tuples: &[Tuple],
+    plan: &TypedPlan,
+    pose: Pose,
+    visited: &[u32],
+) -> Vec<Finding> {
+    let mut out = Vec::new();
+    let used = plan_labels(map, plan, pose);
+    let said = words(instruction).join(" ");
+    let said_words = format!(" {said} ");
+    for t in tuples {
+        // A colour is not an object ("the sofa, the red one" listed as (red, ...)).
+        if is_colour_word(&t.object) {
+            continue;
+        }
+        // Only what the person said counts: a word the model made up as an object
+        // ("start" for "where you started") is not a request for it; a word the person
+        // typed may be a typo of a name the map holds.
+        let literal = said_words.contains(&format!(" {} ", t.object))
+            || said_words.contains(&format!(" {} ", map_core::matcher::plural(&t.object)));
+        let label = if literal {
+            label_of_typed(map, &t.object, pose)
+        } else {
+            label_of(map, &t.object, pose)
+        };
+        let Some(label) = label else {
+            if literal {
+                out.push(Finding::new(
+                    FindingKind::UnknownObject,
+                    format!(
+                        "there is no {} on this map (it holds: {}); if the person meant one of these, use its name in both parts",
+                        t.object,
+                        map_names(map)
+                    ),
+                    format!("I can't find a {} here; the map holds: {}", t.object, map_names(map)),
+                ));
+            }
+            continue;
+        };
+        let region = map.regions.iter().any(|r| r.name == label);
+        if let Some(c) = &t.colour {
+            if !region
+                && !map
+                    .instances
+                    .iter()
+                    .any(|i| i.label == label && same_colour(i.colour.as_deref(), c))
+            {
+                out.push(Finding::new(
+                    FindingKind::NotOnMap,
+                    format!(
+                        "no {label} on this map is {c}: there are {}",
+                        describe_label(map, &label)
+                    ),
+                    format!(
+                        "I see no {c} {label}: there are {}",
+                        describe_label(map, &label)
+                    ),
+                ));
+                continue;
+            }
+        }
+        let reached = map
+            .instances
+            .iter()
+            .any(|i| visited.contains(&i.id) && i.label == label);
+        if !used.contains(&label) && !reached {
+            out.push(Finding::new(
+                FindingKind::Parts,
+                format!(
+                    "the objects line lists {} but the plan does not use a {label}",
+                    t.paper_form()
+                ),
+                format!("I am not sure what to do with the {}", t.object),
+            ));
+        }
+    }
+    out
+}
+
+/// Whether some target satisfies `f`.
+fn any_target(plan: &TypedPlan, f: impl Fn(&Target) -> bool) -> bool {
+    targets(plan).into_iter().any(f)
+}
+
+/// The instruction's words against the plan's targets.
+fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32]) -> Vec<Finding> {
+    let w = words(instruction);
+    let mut out = Vec::new();
+    // Words that belong to a name on the map ("red room") are not modifiers.
+    let mut name_words: Vec<String> = map.regions.iter().flat_map(|r| words(&r.name)).collect();
+    for (l, _) in map.label_counts() {
+        name_words.extend(words(&l));
+    }
+    let directions = ["north", "south", "east", "west", "left", "right"];
+    let mut said: Vec<String> = Vec::new();
+    for (i, word) in w.iter().enumerate() {
+        let prev = if i > 0 { w[i - 1].as_str() } else { "" };
+        let next = w.get(i + 1).map_or("", String::as_str);
+        // Colours.
+        if is_colour_word(word) && !name_words.contains(word) {
+            if let Some(c) = normalise_colour(word) {
+                if said.contains(&c) {
+                    continue;
+                }
+                said.push(c.clone());
+                let reached = map
+                    .instances
+                    .iter()
+                    .any(|i| visited.contains(&i.id) && same_colour(i.colour.as_deref(), &c));
+                if !reached
+                    && !any_target(plan, |t| {
+                        same_colour(t.colour.as_deref(), &c)
+                            || same_colour(t.not_colour.as_deref(), &c)
+                    })
+                {
+                    out.push(Finding::new(
+                        FindingKind::Word,
+                        format!("the person said \"{word}\", but no object in the plan has colour \"{c}\" (or not_colour \"{c}\")"),
+                        format!("what is {word}?"),
+                    ));
+                }
+            }
+            continue;
+        }
+        // Superlatives of distance.
+        if matches!(word.as_str(), "farthest" | "furthest") {
+            let directional = directions.contains(&next);
+            if !any_target(plan, |t| {
+                t.ordinal == -1
+                    || t.order == ObjectOrder::FarToNear
+                    || (directional && t.order != ObjectOrder::NearToFar)
+            }) {
+                out.push(Finding::new(
+                    FindingKind::Word,
+                    format!("the person said \"{word}{}\", but no object in the plan is counted from that end (ordinal -1, or an order)", if directional { format!(" {next}") } else { String::new() }),
+                    format!("which one is the {word}?"),
+                ));
+            }
+            continue;
+        }
+        // Size.
+        let size = match word.as_str() {
+            "biggest" | "largest" => Some(ObjectOrder::LargestToSmallest),
+            "smallest" | "tiniest" => Some(ObjectOrder::SmallestToLargest),
+            _ => None,
+        };
+        if let Some(o) = size {
+            if !any_target(plan, |t| {
+                t.order == o || (t.order == o.reversed() && t.ordinal == -1)
+            }) {
+                out.push(Finding::new(
+                    FindingKind::Word,
+                    format!("the person said \"{word}\", but no object in the plan is counted in the order \"{}\"", o.name()),
+                    format!("which one is the {word}?"),
+                ));
+            }
+            continue;
+        }
+        // Directional superlatives ("westernmost").
+        if let Ok((Some(1), Some(order))) = parse_ordinal_with_order(word) {
+            if let Ok(o) = ObjectOrder::parse(&order) {
+                if !any_target(plan, |t| t.order == o || t.order == o.reversed()) {
+                    out.push(Finding::new(
+                        FindingKind::Word,
+                        format!("the person said \"{word}\", but no object in the plan is counted in the order \"{order}\""),
+                        format!("which one is the {word}?"),
+                    ));
+                }
+            }
+            continue;
+        }
+        // Ordinals: "the third", "number 3", "no. 3", "#3"; "last".
+        let counted =
+            matches!(prev, "the" | "number" | "no" | "#") || (prev == "a" && word == "second");
+        if counted && !name_words.contains(word) {
+            if let Ok(Some(k)) = parse_ordinal(word) {
+                // "the two tables" counts nothing: after "the", only ordinal forms
+                // ("third", "3rd", "last"); after "number", any number.
+                let ordinal_form = ["st", "nd", "rd", "th"].iter().any(|x| word.ends_with(x))
+                    || word == "last"
+                    || word == "second";
+                if (!matches!(prev, "number" | "no" | "#") && !ordinal_form) || k == 1 || k == 0 {
+                    continue;
+                }
+                let last = k == -1;
+                if last && word != "last" {
+                    continue;
+                }
+                let ok = any_target(plan, |t| {
+                    if last {
+                        t.ordinal == -1 || (t.ordinal == 1 && t.order != ObjectOrder::NearToFar)
+                    } else {
+                        t.ordinal.abs() == k
+                    }
+                });
+                if !ok {
+                    out.push(Finding::new(
+                        FindingKind::Word,
+                        format!(
+                            "the person said \"{prev} {word}\", but no object in the plan has ordinal {}",
+                            if last { "-1 (or 1 counted from the other end)".to_string() } else { k.to_string() }
+                        ),
+                        format!("which one is the {word}?"),
+                    ));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Everything found in `plan` and `tuples` for `instruction` on `map`. `visited` holds
+/// the instances the plan's dry run stopped at (empty without a dry run): a colour is
+/// accounted for when a target says it or when the plan reaches an instance of it ("the
+/// sofa that isn't black" on a map of one red and one black sofa is "the red sofa").
+#[must_use]
+pub fn check_answer(
+    map: &IvlMap,
+    instruction: &str,
+    tuples: &[Tuple],
+    plan: &TypedPlan,
+    pose: Pose,
+    visited: &[u32],
+) -> Vec<Finding> {
+    let mut out = check_tuples(map, instruction, tuples, plan, pose, visited);
+    out.extend(check_words(map, instruction, plan, visited));
+    // A plan with no step that moves or turns does nothing the person asked for.
+    if !plan
+        .steps
+        .iter()
+        .any(|s| !matches!(s, Step::Let { .. } | Step::Say(_)))
+    {
+        out.push(Finding::new(
+            FindingKind::Parts,
+            "the plan does not move the robot",
+            "what should I do?",
+        ));
+    }
+    out
+}
+
+/// A dry-run or query error as a finding: the person's side of it is the error itself
+/// ("there are 2 yellow tables; asked for the 3rd").
+#[must_use]
+pub fn runtime_finding(message: &str, line: Option<&str>) -> Finding {
+    Finding::new(
+        FindingKind::Runtime,
+        format!(
+            "running the plan fails: {message}{}",
+            line.map(|l| format!(" (in `{}`)", l.trim()))
+                .unwrap_or_default()
+        ),
+        message.to_string(),
+    )
+}
+
+/// Whether a query error is about the map rather than the plan (the person must choose).
+#[must_use]
+pub fn is_map_question(e: &QueryError) -> bool {
+    matches!(
+        e,
+        QueryError::OrdinalPastCount { .. }
+            | QueryError::NoSuchColour { .. }
+            | QueryError::NotAColour { .. }
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::v2::answer::parse_answer;
+
+    fn map() -> IvlMap {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../examples/scenes/flat-a.scene.json"
+        );
+        IvlMap::from_scene(&map_core::scene::Scene::from_path(path).unwrap())
+    }
+
+    fn findings(instruction: &str, answer: &str) -> Vec<Finding> {
+        let m = map();
+        let a = parse_answer(answer).unwrap();
+        check_answer(&m, instruction, &a.tuples, &a.plan, m.start_pose, &[])
+    }
+
+    #[test]
+    fn an_answer_that_says_everything_passes() {
+        let f = findings(
+            "go to the second black chair, then the red sofa",
+            "objects: [(chair, 2, black), (sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, colour: \"black\"}));\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));",
+        );
+        assert!(f.is_empty(), "{f:?}");
+    }
+
+    #[test]
+    fn a_dropped_colour_is_found_not_fixed() {
+        let f = findings(
+            "go to the sofa, the red one",
+            "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));",
+        );
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert_eq!(f[0].kind, FindingKind::Word);
+        assert!(f[0].to_model.contains("\"red\""), "{}", f[0].to_model);
+    }
+
+    #[test]
+    fn a_dropped_ordinal_and_farthest_are_found() {
+        let f = findings(
+            "go to chair number 2 then the farthest plant",
+            "objects: [(chair, 2, None), (plant, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"plant\"));",
+        );
+        assert!(
+            f.iter().any(|x| x.to_model.contains("\"farthest\"")),
+            "{f:?}"
+        );
+        assert!(
+            f.iter().any(|x| x.to_model.contains("\"number 2\"")),
+            "{f:?}"
+        );
+    }
+
+    #[test]
+    fn unknown_objects_and_colours_the_map_lacks() {
+        let f = findings(
+            "go to the piano",
+            "objects: [(piano, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));",
+        );
+        assert_eq!(f[0].kind, FindingKind::UnknownObject, "{f:?}");
+        assert!(f[0].to_user.contains("piano"), "{f:?}");
+        let f = findings(
+            "go to the purple sofa",
+            "objects: [(sofa, None, purple)]\nplan:\nmove_to_object(get_obj(\"sofa\"));",
+        );
+        assert!(f.iter().any(|x| x.kind == FindingKind::NotOnMap), "{f:?}");
+    }
+
+    #[test]
+    fn words_the_model_made_objects_of_are_not_requests() {
+        let f = findings(
+            "go to the grey sofa and back to where you started",
+            "objects: [(grey, None, None), (sofa, None, red), (start, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to_start();",
+        );
+        // "grey" and "start" are not objects the person asked for; "grey" is a colour
+        // the plan does not carry.
+        assert!(
+            f.iter().all(|x| x.kind != FindingKind::UnknownObject),
+            "{f:?}"
+        );
+        assert!(
+            f.iter()
+                .any(|x| x.kind == FindingKind::Word && x.to_model.contains("grey")),
+            "{f:?}"
+        );
+    }
+
+    #[test]
+    fn a_typo_names_the_object_it_is_closest_to() {
+        let f = findings(
+            "go to the tabel",
+            "objects: [(tabel, None, None)]\nplan:\nmove_to_object(get_obj(\"table\"));",
+        );
+        assert!(f.is_empty(), "{f:?}");
+    }
+
+    #[test]
+    fn grey_is_gray_and_cardinals_are_not_ordinals() {
+        let f = findings(
+            "stop between the two sofas, then go to the gray one",
+            "objects: [(sofa, None, None), (sofa, None, grey)]\nplan:\nmove_between_the_two(\"sofa\");\nmove_to_object(get_obj(\"sofa\", #{colour: \"grey\"}));",
+        );
+        assert!(f.iter().all(|x| x.kind != FindingKind::Word), "{f:?}");
+    }
+
+    #[test]
+    fn the_first_step_and_plain_counts_are_not_ordinals() {
+        let f = findings(
+            "first go to the sofa, then turn 90 degrees",
+            "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\nturn(90);",
+        );
+        assert!(f.is_empty(), "{f:?}");
+    }
+
+    #[test]
+    fn directional_superlatives_and_size() {
+        let ok = findings(
+            "go to the westernmost chair and then the biggest sofa",
+            "objects: [(chair, 1, None, west_to_east), (sofa, 1, None, largest_to_smallest)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 1, order: \"west_to_east\"}));\nmove_to_object(get_obj(\"sofa\", #{ordinal: 1, order: \"largest_to_smallest\"}));",
+        );
+        assert!(ok.is_empty(), "{ok:?}");
+        let bad = findings(
+            "go to the westernmost chair and then the biggest sofa",
+            "objects: [(chair, None, None), (sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"sofa\"));",
+        );
+        assert_eq!(bad.len(), 2, "{bad:?}");
+    }
+}

@@ -1,0 +1,445 @@
+//! The grammar of the one-call answer, built per request from planner_dsl's registry and
+//! the map's vocabulary.
+//!
+//! The objects line is free in its words (they are the person's own: "couch", "piano"),
+//! held to the paper's tuple shape; the plan may call only the typed plan's step
+//! functions ([`planner_dsl::typed::STEP_FUNCTIONS`], each with its registry signature)
+//! and pick objects only by the names, colours and regions this map holds, ordinals as
+//! integers, orders from map_core. A local model under it cannot call anything outside
+//! the library or name anything the map lacks; what it cannot say (a colour the map
+//! has no object in) the checks find in the objects line and ask about.
+
+use map_core::matcher::{synonyms, COLOUR_WORDS};
+use map_core::{IvlMap, ObjectOrder};
+use planner_dsl::typed::{PICK_FUNCTION, STEP_FUNCTIONS};
+use planner_dsl::ParamType;
+
+/// What a map lets a plan name.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Vocabulary {
+    /// Object names: the map's labels and their synonyms.
+    pub names: Vec<String>,
+    /// Colours some instance has.
+    pub colours: Vec<String>,
+    /// Region (room) names.
+    pub regions: Vec<String>,
+    /// Object ids the plan may name with `get_instance` (what the conversation visited;
+    /// empty outside a conversation).
+    pub ids: Vec<u32>,
+}
+
+impl Vocabulary {
+    /// The vocabulary of `map`, sorted and without duplicates.
+    #[must_use]
+    pub fn for_map(map: &IvlMap) -> Self {
+        let mut names = Vec::new();
+        for (label, _) in map.label_counts() {
+            names.extend(synonyms(&label).into_iter().map(str::to_string));
+            names.push(label);
+        }
+        let mut colours: Vec<String> = map
+            .instances
+            .iter()
+            .filter_map(|i| i.colour.clone())
+            .collect();
+        let mut regions: Vec<String> = map.regions.iter().map(|r| r.name.clone()).collect();
+        for v in [&mut names, &mut colours, &mut regions] {
+            v.retain(|s| !s.trim().is_empty());
+            v.sort();
+            v.dedup();
+        }
+        Self {
+            names,
+            colours,
+            regions,
+            ids: Vec::new(),
+        }
+    }
+}
+
+/// A GBNF string literal of `s`.
+fn q(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// Alternatives of literals, longest first (so that none is cut short by a prefix).
+fn alt<S: AsRef<str>>(words: &[S], quoted: bool) -> String {
+    let mut w: Vec<&str> = words.iter().map(AsRef::as_ref).collect();
+    w.sort_by_key(|s| std::cmp::Reverse(s.len()));
+    w.dedup();
+    w.iter()
+        .map(|s| if quoted { q(&format!("\"{s}\"")) } else { q(s) })
+        .collect::<Vec<_>>()
+        .join(" | ")
+}
+
+fn orders(with_default: bool) -> Vec<&'static str> {
+    ObjectOrder::ALL
+        .iter()
+        .map(|(_, n)| *n)
+        .filter(|n| with_default || *n != ObjectOrder::NearToFar.name())
+        .collect()
+}
+
+/// The two grammar languages the answer's grammar is written in: GBNF for llama.cpp's
+/// grammar sampler (and servers that take it), Lark for llguidance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Dialect {
+    Gbnf,
+    Lark,
+}
+
+/// A grammar being written in one dialect: rules, and character-level patterns (GBNF
+/// character classes, Lark regular expressions).
+struct Writer {
+    d: Dialect,
+    out: String,
+}
+
+impl Writer {
+    fn new(d: Dialect) -> Self {
+        Self {
+            d,
+            out: String::new(),
+        }
+    }
+
+    /// `name ::= body` (GBNF) or `name: body` (Lark); the start rule is `root` or `start`.
+    fn rule(&mut self, name: &str, body: &str) {
+        let name = match (self.d, name) {
+            (Dialect::Lark, "root") => "start",
+            _ => name,
+        };
+        let op = if self.d == Dialect::Gbnf {
+            " ::= "
+        } else {
+            ": "
+        };
+        self.out.push_str(name);
+        self.out.push_str(op);
+        self.out.push_str(body);
+        self.out.push('\n');
+    }
+
+    /// A character-level pattern: `gbnf` as GBNF, `regex` as a Lark regular expression.
+    fn pattern(&self, gbnf: &str, regex: &str) -> String {
+        match self.d {
+            Dialect::Gbnf => gbnf.to_string(),
+            Dialect::Lark => format!("/{regex}/"),
+        }
+    }
+}
+
+/// The objects line's rules (`objects` and what it uses).
+fn objects_rules(w: &mut Writer, map_colours: &[String]) {
+    let mut colours: Vec<String> = COLOUR_WORDS.iter().map(|s| (*s).to_string()).collect();
+    colours.extend(map_colours.iter().cloned());
+    w.rule("objects", "\"objects: [\" tuple (\", \" tuple)* \"]\"");
+    w.rule(
+        "tuple",
+        "\"(\" tword \", \" tordinal \", \" tcolour (\", \" torder)? \")\"",
+    );
+    let tword = w.pattern(
+        "[a-z] [a-z-]{0,15} (\" \" [a-z] [a-z-]{0,15}){0,2}",
+        "[a-z][a-z\\-]{0,15}( [a-z][a-z\\-]{0,15}){0,2}",
+    );
+    w.rule("tword", &tword);
+    let n = w.pattern("[1-9] [0-9]?", "[1-9][0-9]?");
+    w.rule("tordinal", &format!("\"None\" | \"last\" | {n}"));
+    w.rule("tcolour", &format!("\"None\" | {}", alt(&colours, false)));
+    w.rule("torder", &alt(&orders(false), false));
+}
+
+fn objects_only(d: Dialect) -> String {
+    let mut w = Writer::new(d);
+    w.rule("root", "objects");
+    objects_rules(&mut w, &[]);
+    w.out
+}
+
+/// GBNF for the objects line alone (extraction without a map); rule `root`.
+#[must_use]
+pub fn objects_grammar() -> String {
+    objects_only(Dialect::Gbnf)
+}
+
+/// [`objects_grammar`] in Lark (llguidance); rule `start`.
+#[must_use]
+pub fn objects_lark() -> String {
+    objects_only(Dialect::Lark)
+}
+
+/// The rule that writes an argument of type `ty`.
+fn arg_rule(ty: ParamType) -> &'static str {
+    match ty {
+        ParamType::Object => "obj",
+        ParamType::Name => "pname",
+        ParamType::Selection => "selmap",
+        ParamType::Position => "pos",
+        ParamType::Distance | ParamType::Angle => "num",
+        ParamType::Text => "text",
+        ParamType::Ordinal => "int",
+        ParamType::Id => "inst",
+        ParamType::Colour => "qcolour",
+        ParamType::Order => "qorder",
+    }
+}
+
+/// The call rule of a registered function: `"name(" args ")"`, optional parameters
+/// optional. `None` when the registry does not hold it.
+fn call_rule(name: &str) -> Option<String> {
+    let f = planner_dsl::lookup(name)?;
+    let mut r = q(&format!("{name}("));
+    let mut first = true;
+    let mut open = 0;
+    for p in f.params {
+        let sep = if first { "" } else { ", " };
+        first = false;
+        let rule = arg_rule(p.ty);
+        if p.optional {
+            r.push_str(" (");
+            open += 1;
+        }
+        if !sep.is_empty() {
+            r.push(' ');
+            r.push_str(&q(sep));
+        }
+        r.push(' ');
+        r.push_str(rule);
+    }
+    for _ in 0..open {
+        r.push_str(")?");
+    }
+    r.push(' ');
+    r.push_str(&q(")"));
+    Some(r)
+}
+
+/// GBNF for the whole answer: the objects line, `plan:`, then one typed step per line,
+/// with names, colours and regions from `vocab`. Rule `root`.
+///
+/// ```
+/// use agent::v2::grammar::{answer_grammar, Vocabulary};
+/// let v = Vocabulary { names: vec!["chair".into()], colours: vec!["red".into()], ..Vocabulary::default() };
+/// let g = answer_grammar(&v);
+/// assert!(g.starts_with("root ::="));
+/// assert!(g.contains("\"move_to_object(\""));
+/// assert!(!g.contains("region: "), "no regions on this map");
+/// ```
+#[must_use]
+pub fn answer_grammar(vocab: &Vocabulary) -> String {
+    answer(vocab, Dialect::Gbnf)
+}
+
+/// [`answer_grammar`] in Lark, for llguidance (the same language); rule `start`.
+#[must_use]
+pub fn answer_lark(vocab: &Vocabulary) -> String {
+    answer(vocab, Dialect::Lark)
+}
+
+fn answer(vocab: &Vocabulary, d: Dialect) -> String {
+    let mut w = Writer::new(d);
+    // Statements are separated (not ended) by newlines, as in the worked examples, so
+    // that after the last `;` the model can end its turn as it saw there; at most 16
+    // statements, so that a weak model that repeats itself stops.
+    w.rule("root", "objects \"\\nplan:\\n\" stmt (\"\\n\" stmt){0,15}");
+    objects_rules(&mut w, &vocab.colours);
+    let steps: Vec<String> = STEP_FUNCTIONS.iter().filter_map(|n| call_rule(n)).collect();
+    w.rule("stmt", "letstmt | step");
+    w.rule("letstmt", "\"let \" var \" = \" pick \";\"");
+    w.rule("step", &format!("({}) \";\"", steps.join(" | ")));
+    let var = w.pattern("[a-z] [a-z0-9_]{0,15}", "[a-z][a-z0-9_]{0,15}");
+    w.rule("var", &var);
+    w.rule(
+        "pick",
+        &format!(
+            "{} pname (\", \" selmap)? \")\"",
+            q(&format!("{PICK_FUNCTION}("))
+        ),
+    );
+    if vocab.ids.is_empty() {
+        w.rule("obj", "pick | qname | var");
+    } else {
+        let ids: Vec<String> = vocab.ids.iter().map(u32::to_string).collect();
+        w.rule("obj", "pick | qname | var | inst");
+        w.rule(
+            "inst",
+            &format!("\"get_instance(\" ({}) \")\"", alt(&ids, false)),
+        );
+    }
+    // Objects are picked by their names; a bare name may also be a region (a room).
+    if vocab.names.is_empty() {
+        let free = w.pattern(
+            "\"\\\"\" [a-z] [a-z ]{0,24} \"\\\"\"",
+            "\"[a-z][a-z ]{0,24}\"",
+        );
+        w.rule("pname", &free);
+    } else {
+        w.rule("pname", &alt(&vocab.names, true));
+    }
+    if vocab.regions.is_empty() {
+        w.rule("qname", "pname");
+    } else {
+        w.rule("qname", &format!("pname | {}", alt(&vocab.regions, true)));
+    }
+    // The selection map's keys in a fixed order, each optional, at least one.
+    let mut keys = vec!["\"ordinal: \" int".to_string()];
+    if !vocab.colours.is_empty() {
+        keys.push("\"colour: \" qcolour".into());
+        keys.push("\"not_colour: \" qcolour".into());
+        w.rule("qcolour", &alt(&vocab.colours, true));
+    }
+    keys.push("\"order: \" qorder".into());
+    if !vocab.regions.is_empty() {
+        keys.push("\"region: \" qregion".into());
+        w.rule("qregion", &alt(&vocab.regions, true));
+    }
+    keys.push("\"near: \" obj".into());
+    w.rule("selmap", "\"#{\" sel0 \"}\"");
+    let n = keys.len();
+    for (i, k) in keys.iter().enumerate() {
+        if i + 1 == n {
+            w.rule(&format!("sel{i}"), k);
+        } else {
+            w.rule(
+                &format!("sel{i}"),
+                &format!("{k} (\", \" sel{next})? | sel{next}", next = i + 1),
+            );
+        }
+    }
+    w.rule("qorder", &alt(&orders(true), true));
+    let int = w.pattern("\"-\"? [1-9] [0-9]?", "-?[1-9][0-9]?");
+    w.rule("int", &int);
+    let num = w.pattern(
+        "\"-\"? [0-9] [0-9]{0,2} (\".\" [0-9] [0-9]?)?",
+        "-?[0-9]{1,3}(\\.[0-9]{1,2})?",
+    );
+    w.rule("num", &num);
+    w.rule("pos", "\"[\" num \", \" num \"]\"");
+    let text = w.pattern(
+        "\"\\\"\" [^\"\\\\\\n]{0,80} \"\\\"\"",
+        "\"[^\"\\\\\\n]{0,80}\"",
+    );
+    w.rule("text", &text);
+    w.out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn vocab() -> Vocabulary {
+        Vocabulary {
+            names: vec!["chair".into(), "sofa".into(), "couch".into()],
+            colours: vec!["red".into(), "black".into()],
+            regions: vec!["kitchen".into()],
+            ids: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn every_step_function_of_the_registry_is_offered_and_nothing_else() {
+        let g = answer_grammar(&vocab());
+        for f in STEP_FUNCTIONS {
+            assert!(g.contains(&format!("\"{f}(\"")), "{f}");
+        }
+        for f in planner_dsl::registry() {
+            let offered = g.contains(&format!("\"{}(\"", f.name));
+            assert_eq!(
+                offered,
+                STEP_FUNCTIONS.contains(&f.name) || f.name == PICK_FUNCTION,
+                "{}",
+                f.name
+            );
+        }
+        // In a conversation, the objects it visited can be named by id, and only those.
+        let mut v = vocab();
+        v.ids = vec![17, 2];
+        let g = answer_grammar(&v);
+        assert!(
+            g.contains("inst ::= \"get_instance(\" (\"17\" | \"2\") \")\""),
+            "{g}"
+        );
+        assert!(!g.contains("eval"));
+    }
+
+    #[test]
+    fn names_colours_and_regions_come_from_the_map() {
+        let g = answer_grammar(&vocab());
+        for lit in [
+            "\"\\\"chair\\\"\"",
+            "\"\\\"couch\\\"\"",
+            "\"\\\"kitchen\\\"\"",
+            "\"\\\"red\\\"\"",
+        ] {
+            assert!(g.contains(lit), "{lit} in\n{g}");
+        }
+        assert!(!g.contains("\"\\\"yellow\\\"\""), "a colour the map lacks");
+        // Every rule used is defined.
+        for rule in [
+            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel0",
+            "qcolour", "qregion", "qorder", "int", "num", "pos", "text", "var",
+        ] {
+            assert!(g.contains(&format!("\n{rule} ::=")), "{rule}");
+        }
+    }
+
+    #[test]
+    fn the_lark_form_has_the_same_rules() {
+        let g = answer_lark(&vocab());
+        assert!(g.starts_with("start: objects"), "{g}");
+        assert!(!g.contains("::="), "{g}");
+        for rule in [
+            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel0",
+            "qcolour", "qregion", "qorder", "int", "num", "pos", "text", "var",
+        ] {
+            assert!(g.contains(&format!("\n{rule}: ")), "{rule}");
+        }
+        // Character classes are regular expressions in Lark.
+        assert!(g.contains("int: /-?[1-9][0-9]?/"), "{g}");
+        assert!(objects_lark().starts_with("start: objects\n"));
+    }
+
+    #[test]
+    fn a_map_without_colours_or_regions_leaves_their_keys_out() {
+        let g = answer_grammar(&Vocabulary {
+            names: vec!["chair".into()],
+            ..Vocabulary::default()
+        });
+        assert!(!g.contains("qcolour"), "{g}");
+        assert!(!g.contains("qregion"), "{g}");
+    }
+
+    #[test]
+    fn vocabulary_of_a_scene() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../examples/scenes/flat-a.scene.json"
+        );
+        let map = IvlMap::from_scene(&map_core::scene::Scene::from_path(path).unwrap());
+        let v = Vocabulary::for_map(&map);
+        for n in ["sofa", "couch", "refrigerator", "fridge"] {
+            assert!(v.names.iter().any(|x| x == n), "{n}: {:?}", v.names);
+        }
+        assert!(v.colours.iter().any(|c| c == "red"), "{:?}", v.colours);
+        assert!(
+            v.regions.iter().any(|r| r == "living room"),
+            "{:?}",
+            v.regions
+        );
+        let mut sorted = v.names.clone();
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(sorted, v.names);
+    }
+}

@@ -1,0 +1,243 @@
+//! The language layer v2: one constrained model call per instruction.
+//!
+//! For an instruction the model gets a static system message (the step functions from
+//! planner_dsl's registry, then a summary of this map: cached by a prefix-caching
+//! backend), the few worked examples most similar to the instruction
+//! ([`examples`]), and the instruction. It answers the tuples, then the plan
+//! ([`answer`]), held by a grammar built for this map ([`grammar`]). The plan is typed
+//! ([`planner_dsl::typed::TypedPlan`]); [`check`] compares it with the instruction's
+//! words, the objects line and the map, and a dry run runs it. A disagreement gets one
+//! targeted re-ask naming it; if the second answer still disagrees the person gets a
+//! question (or a refusal, for an object the map does not hold). No rule edits the
+//! model's answer: the plan that runs is the one the model wrote, printed canonically.
+
+pub mod answer;
+pub mod check;
+pub mod examples;
+pub mod grammar;
+
+use std::time::Instant;
+
+use llm::{ChatMessage, CompletionRequest, LlmBackend};
+use map_core::StopTarget;
+use planner_dsl::{Limits, Plan};
+
+use crate::pipeline::{
+    scene_summary, LanguageError, Outcome, PlanContext, PlanSource, PlannedInstruction, Timing,
+};
+use crate::prompts::Prompts;
+use crate::tuples::{parse_tuples, Tuple};
+
+use self::answer::{objects_part, parse_answer, Answer};
+use self::check::{check_answer, runtime_finding, Finding, FindingKind};
+use self::grammar::{answer_grammar, answer_lark, objects_grammar, objects_lark, Vocabulary};
+
+/// The messages of one request: system (+ scene), the nearest worked examples, the
+/// instruction.
+fn messages(
+    prompts: &Prompts,
+    instruction: &str,
+    scene: Option<&str>,
+    history: Option<&str>,
+    k: usize,
+) -> Result<Vec<ChatMessage>, LanguageError> {
+    let index = prompts.example_index()?;
+    let mut m = vec![ChatMessage::system(prompts.v2_system(scene)?)];
+    for ex in index.nearest(instruction, k) {
+        m.push(prompts.v2_request(&ex.instruction, ex.history.as_deref())?);
+        m.push(ChatMessage::assistant(ex.answer.clone()));
+    }
+    m.push(prompts.v2_request(instruction, history)?);
+    Ok(m)
+}
+
+/// The tuples of `instruction` as the one-call answer's objects line gives them (no map:
+/// the extraction suites' task). Asks only for the objects line.
+///
+/// # Errors
+/// [`LanguageError`]: prompts, backend, or an objects line that does not read.
+pub fn extract(
+    backend: &dyn LlmBackend,
+    prompts: &Prompts,
+    instruction: &str,
+    options: &crate::PlanOptions,
+) -> Result<(Vec<Tuple>, Timing), LanguageError> {
+    let t0 = Instant::now();
+    let mut req = CompletionRequest::new(
+        messages(prompts, instruction, None, None, options.examples)?,
+        options.extract_max_tokens,
+    );
+    req.stop = vec!["\n".into()];
+    if options.tuple_grammar {
+        req.grammar = Some(objects_grammar());
+        if options.llguidance {
+            req.lark = Some(objects_lark());
+        }
+    }
+    let c = backend.complete(&req)?;
+    let mut timing = Timing::default();
+    timing.add(&c);
+    let text = objects_part(&c.text).map_or(c.text.as_str(), |(_, t)| t);
+    let tuples = parse_tuples(text).map_err(|source| LanguageError::Tuples {
+        source,
+        answer: c.text.clone(),
+    })?;
+    timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
+    Ok((tuples, timing))
+}
+
+/// An answer that read and passed every check, compiled.
+struct Accepted {
+    answer: Answer,
+    script: String,
+    plan: Plan,
+}
+
+/// Reads, checks and dry-runs one answer.
+fn assess(text: &str, instruction: &str, ctx: &PlanContext<'_>) -> Result<Accepted, Vec<Finding>> {
+    let answer = parse_answer(text).map_err(|e| {
+        vec![Finding {
+            kind: FindingKind::Unreadable,
+            to_model: format!(
+                "{e}; answer with the objects line, then plan: and one call per line"
+            ),
+            to_user: "I could not make a plan of that".into(),
+        }]
+    })?;
+    let pose = ctx.pose();
+    let script = answer.plan.to_rhai();
+    let plan = Plan::compile(&script).map_err(|e| {
+        vec![Finding {
+            kind: FindingKind::Unreadable,
+            to_model: format!("the plan does not compile: {e}"),
+            to_user: "I could not make a plan of that".into(),
+        }]
+    })?;
+    let mut visited = Vec::new();
+    let mut run_error = None;
+    if ctx.options.dry_run {
+        if let Some(robot) = ctx.robot {
+            let d = planner_dsl::dry_run(&plan, ctx.map, robot, &Limits::default());
+            for s in &d.trajectory.stops {
+                match s.target {
+                    StopTarget::Instance(i) => visited.push(i),
+                    StopTarget::Between([a, b]) => visited.extend([a, b]),
+                    _ => {}
+                }
+            }
+            if let Some(e) = d.outcome.error {
+                let line = script.lines().nth(e.span.line.wrapping_sub(1));
+                run_error = Some(runtime_finding(&e.message, line));
+            }
+        }
+    }
+    let mut found = check_answer(
+        ctx.map,
+        instruction,
+        &answer.tuples,
+        &answer.plan,
+        pose,
+        &visited,
+    );
+    // The map's own answer first: it says what the map holds.
+    if let Some(e) = run_error {
+        found.insert(0, e);
+    }
+    if !found.is_empty() {
+        return Err(found);
+    }
+    Ok(Accepted {
+        answer,
+        script,
+        plan,
+    })
+}
+
+/// What the person is told when the findings stand after the re-ask.
+fn settle(findings: &[Finding]) -> Outcome {
+    let unknown: Vec<&Finding> = findings
+        .iter()
+        .filter(|f| f.kind == FindingKind::UnknownObject)
+        .collect();
+    if let Some(f) = unknown.first() {
+        return Outcome::Refusal(format!("I can't do that: {}.", f.to_user));
+    }
+    let mut seen: Vec<&str> = Vec::new();
+    for f in findings {
+        if !seen.contains(&f.to_user.as_str()) {
+            seen.push(&f.to_user);
+        }
+    }
+    Outcome::Question(format!(
+        "I am not sure I understood: {}. Could you say it another way?",
+        seen.join("; ")
+    ))
+}
+
+/// Plans one instruction with one model call (and at most one re-ask).
+///
+/// # Errors
+/// [`LanguageError`]: prompts or backend. A plan that does not settle is an
+/// [`Outcome::Question`] or [`Outcome::Refusal`], not an error.
+pub fn plan_instruction(
+    backend: &dyn LlmBackend,
+    prompts: &Prompts,
+    instruction: &str,
+    ctx: &PlanContext<'_>,
+) -> Result<Outcome, LanguageError> {
+    let t0 = Instant::now();
+    let scene = scene_summary(ctx.map);
+    let mut msgs = messages(
+        prompts,
+        instruction,
+        Some(&scene),
+        ctx.history.as_deref(),
+        ctx.options.examples,
+    )?;
+    let vocab = {
+        let mut v = Vocabulary::for_map(ctx.map);
+        v.ids.clone_from(&ctx.references);
+        v
+    };
+    let grammar = ctx.options.answer_grammar.then(|| answer_grammar(&vocab));
+    let lark = (ctx.options.answer_grammar && ctx.options.llguidance).then(|| answer_lark(&vocab));
+    let mut timing = Timing::default();
+    let mut attempts = Vec::new();
+    let mut findings = Vec::new();
+    for round in 0..=ctx.options.max_repairs.min(1) {
+        let mut req = CompletionRequest::new(msgs.clone(), ctx.options.plan_max_tokens);
+        req.grammar.clone_from(&grammar);
+        req.lark.clone_from(&lark);
+        let c = backend.complete(&req)?;
+        timing.add(&c);
+        attempts.push(c.text.clone());
+        match assess(&c.text, instruction, ctx) {
+            Ok(a) => {
+                timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
+                return Ok(Outcome::Plan(Box::new(PlannedInstruction {
+                    instruction: instruction.to_string(),
+                    tuples: a.answer.tuples,
+                    script: a.script,
+                    plan: a.plan,
+                    source: PlanSource::Llm { repairs: round },
+                    timing,
+                    attempts,
+                    fixes: Vec::new(),
+                })));
+            }
+            Err(f) => {
+                tracing::debug!(round, answer = %c.text, findings = ?f, "answer disagrees; re-asking once");
+                // The re-ask is the same request with what the checks found added to it
+                // (measured: with the first answer left in the conversation, the model
+                // repeated it word for word under greedy decoding).
+                let notes: Vec<String> = f.iter().map(|x| x.to_model.clone()).collect();
+                let reask = prompts.v2_reask(&notes)?;
+                if let Some(last) = msgs.last_mut() {
+                    last.content = format!("{}\n{}", last.content, reask.content);
+                }
+                findings = f;
+            }
+        }
+    }
+    Ok(settle(&findings))
+}
