@@ -75,6 +75,7 @@ impl LlmBackend for Scripted {
             prompt_ms: 0.0,
             generate_ms: 0.0,
             finish_reason: FinishReason::Stop,
+            forced_tokens: 0,
         })
     }
 }

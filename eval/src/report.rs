@@ -303,6 +303,37 @@ mod tests {
     }
 
     #[test]
+    fn chat_reports_turn_accuracy_and_dialogue_success() {
+        let turn = |ok: bool| crate::chat::TurnResult {
+            say: "x".into(),
+            tuples: None,
+            script: None,
+            trajectory: Trajectory::default(),
+            question: None,
+            error: None,
+            reached: vec![ok],
+            latency_ms: 1,
+        };
+        let mut a = case("d1", true, 5, None);
+        a.turns = Some(vec![turn(true), turn(true)]);
+        let mut b = case("d2", false, 7, None);
+        b.turns = Some(vec![turn(true), turn(false), turn(true)]);
+        let s = summarise(&[a, b]);
+        assert_eq!(s.turn_accuracy, Some(0.8));
+        assert_eq!(s.dialogue_success, Some(0.5));
+        assert!(s.t.is_none(), "a chat report has no T_k");
+        let r = Report::new(
+            "d.chat.jsonl".into(),
+            "b".into(),
+            "m".into(),
+            "p".into(),
+            None,
+            vec![],
+        );
+        assert!(r.summary.turn_accuracy.is_none());
+    }
+
+    #[test]
     fn percentiles_are_nearest_rank() {
         let v: Vec<u64> = (1..=20).collect();
         assert_eq!(percentile(&v, 50.0), 10);

@@ -638,6 +638,45 @@ mod tests {
     }
 
     #[test]
+    fn chat_suites_read_and_errors_name_the_turn() {
+        let public =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/suites/dialogues.chat.jsonl");
+        let ds = load_chat_suite(&public).unwrap();
+        assert!(ds.len() >= 20, "{} dialogues", ds.len());
+        assert!(ds.iter().any(|d| d.turns.iter().any(|t| t.expect_question)));
+        assert!(ds.iter().all(|d| d.turns.len() >= 2));
+
+        let d = tempfile::tempdir().unwrap();
+        let scene =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scenes/flat-a.scene.json");
+        let scene = scene.display().to_string();
+        let ok = format!(
+            r#"{{"id": "c1", "scene": "{scene}", "turns": [{{"say": "go to the fridge", "subgoals": [{{"object": 16}}]}}, {{"say": "the purple sofa", "subgoals": [], "expect": "question"}}]}}"#
+        );
+        let p = write(d.path(), "a.chat.jsonl", &format!("{ok}\n"));
+        let ds = load_chat_suite(&p).unwrap();
+        assert_eq!(ds[0].turns.len(), 2);
+        assert!(ds[0].turns[1].expect_question && ds[0].turns[1].subgoals.is_empty());
+
+        let bad = format!(
+            r#"{{"id": "c1", "scene": "{scene}", "turns": [{{"say": "go", "subgoals": [{{"object": 16}}]}}, {{"say": "then there", "subgoals": [{{"object": 999}}]}}]}}"#
+        );
+        let p = write(d.path(), "b.chat.jsonl", &format!("{bad}\n"));
+        let e = load_chat_suite(&p).unwrap_err().to_string();
+        assert!(e.contains("b.chat.jsonl:1:"), "{e}");
+        assert!(e.contains("turns[1].subgoals[0].object"), "{e}");
+        let empty = format!(
+            r#"{{"id": "c1", "scene": "{scene}", "turns": [{{"say": "go", "subgoals": []}}]}}"#
+        );
+        let p = write(d.path(), "c.chat.jsonl", &format!("{empty}\n"));
+        let e = load_chat_suite(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("turns[0].subgoals") && e.contains("question"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn extract_suite_reads_and_reports_line_and_field() {
         let d = tempfile::tempdir().unwrap();
         let p = write(

@@ -213,6 +213,15 @@ pub struct Completion {
     /// Why generation ended.
     #[serde(default)]
     pub finish_reason: FinishReason,
+    /// Of the generated tokens, how many a grammar forced and were decoded in a batch
+    /// instead of sampled one by one (llama with a Lark grammar; 0 elsewhere).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub forced_tokens: u32,
+}
+
+#[allow(clippy::trivially_copy_pass_by_ref)] // serde's skip_serializing_if passes a reference
+fn is_zero(n: &u32) -> bool {
+    *n == 0
 }
 
 /// A language model that completes chats. Synchronous: call it from a plain thread (an

@@ -687,6 +687,7 @@ impl Worker<'_> {
         let max_stop = req.stop.iter().map(String::len).max().unwrap_or(0);
         let mut out: Vec<u8> = Vec::new();
         let mut n_gen = 0usize;
+        let mut n_forced = 0usize;
         let mut pos = tokens.len();
         let finish = loop {
             if n_gen >= max_new {
@@ -710,21 +711,32 @@ impl Worker<'_> {
             }
             // Fast-forward: the tokens the grammar forces after this one are not sampled
             // one by one; they join this token in one batch.
-            let mut forced = Vec::new();
+            // llama-cpp-2's token environment is not a canonical tokenizer, so llguidance
+            // gives the forced bytes; they are tokenized here with the model's vocabulary.
+            let mut forced: Vec<LlamaToken> = Vec::new();
+            let mut lost = false;
             if let Some(m) = shadow.as_mut() {
                 if m.consume_token(tok.0.cast_unsigned()).is_ok() {
                     let room = (max_new - n_gen).min(n_batch.saturating_sub(1));
-                    forced = m.compute_ff_tokens();
-                    forced.truncate(room);
-                    if !forced.is_empty() && m.consume_tokens(&forced).is_err() {
-                        forced.clear();
+                    let bytes = m.compute_ff_bytes();
+                    if !bytes.is_empty() {
+                        forced = vocab.tokenize(&bytes, false, false);
+                        forced.truncate(room);
+                        let ids: Vec<u32> = forced.iter().map(|t| t.0.cast_unsigned()).collect();
+                        if m.consume_tokens(&ids).is_err() {
+                            // The shadow cannot follow: stop fast-forwarding for this answer.
+                            forced.clear();
+                            lost = true;
+                        }
                     }
                 }
             }
+            if lost {
+                shadow = None;
+            }
             batch.clear();
-            let step: Vec<LlamaToken> = std::iter::once(tok)
-                .chain(forced.iter().map(|t| LlamaToken(t.cast_signed())))
-                .collect();
+            let step: Vec<LlamaToken> =
+                std::iter::once(tok).chain(forced.iter().copied()).collect();
             for (j, &t) in step.iter().enumerate() {
                 add(&mut batch, t, pos + j, seq, j + 1 == step.len())?;
             }
@@ -738,6 +750,7 @@ impl Worker<'_> {
             for &t in &step[1..] {
                 sampler.accept(t);
                 n_gen += 1;
+                n_forced += 1;
                 let before = out.len();
                 out.extend_from_slice(&vocab.token_to_piece(t, false, None));
                 if let Some(cut) = find_stop(&out, before, max_stop, &req.stop) {
@@ -759,6 +772,7 @@ impl Worker<'_> {
             prompt_ms,
             generate_ms,
             finish_reason: finish,
+            forced_tokens: count(n_forced),
         })
     }
 }

@@ -505,6 +505,7 @@ fn parse_completion(url: &str, body: &str, elapsed_ms: f64) -> Result<Completion
         prompt_ms,
         generate_ms,
         finish_reason,
+        forced_tokens: 0,
     })
 }
 

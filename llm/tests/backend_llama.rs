@@ -172,6 +172,48 @@ fn grammar_forces_the_answer_set() {
 }
 
 #[test]
+fn a_lark_grammar_runs_under_llguidance_with_forced_tokens_fast_forwarded() {
+    let _g = serial();
+    let Some(b) = smol(2048) else { return };
+    let mut req = ask(
+        "Answer with one word.",
+        "Is the sky green? Answer yes or no.",
+        8,
+    );
+    req.lark = Some(r#"start: "yes" | "no""#.into());
+    // The Lark grammar wins over a GBNF one that would admit something else.
+    req.grammar = Some(r#"root ::= "maybe""#.into());
+    let c = b.complete(&req).unwrap();
+    assert!(c.text == "yes" || c.text == "no", "{c:?}");
+    assert_eq!(c.finish_reason, FinishReason::Stop);
+
+    // Long forced stretches (the literals) are decoded in batches, not sampled token by
+    // token: the answer is whole, and its tokens are counted as generated.
+    req.grammar = None;
+    req.max_tokens = 120;
+    req.lark = Some(
+        r#"start: "objects: [(zebra, " /[1-9]/ ", None)]\nplan:\nmove_to_object(get_obj(\"zebra\"));""#.into(),
+    );
+    let c = b.complete(&req).unwrap();
+    assert!(c.text.starts_with("objects: [(zebra, "), "{c:?}");
+    assert!(
+        c.text
+            .ends_with(", None)]\nplan:\nmove_to_object(get_obj(\"zebra\"));"),
+        "{c:?}"
+    );
+    assert!(c.completion_tokens >= 10, "{c:?}");
+    // Only the digit is sampled (and the first token); the rest is forced.
+    assert!(c.forced_tokens + 3 >= c.completion_tokens, "{c:?}");
+    assert_eq!(c.finish_reason, FinishReason::Stop);
+
+    // A malformed Lark grammar is a grammar error, and the backend keeps working.
+    req.lark = Some("start: undefined_rule".into());
+    assert!(matches!(b.complete(&req), Err(LlmError::Grammar { .. })));
+    req.lark = None;
+    assert!(b.complete(&req).is_ok());
+}
+
+#[test]
 fn json_schema_becomes_a_grammar() {
     let _g = serial();
     let Some(b) = smol(2048) else { return };

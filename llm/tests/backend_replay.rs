@@ -138,6 +138,7 @@ fn write_cassette(records: &[(CompletionRequest, &str)]) -> (tempfile::TempDir, 
                 prompt_ms: 1.0,
                 generate_ms: 2.0,
                 finish_reason: llm::FinishReason::Stop,
+                forced_tokens: 0,
             },
         };
         s.push_str(&serde_json::to_string(&rec).unwrap());
