@@ -174,7 +174,11 @@ fn grammar_forces_the_answer_set() {
 #[test]
 fn a_lark_grammar_runs_under_llguidance_with_forced_tokens_fast_forwarded() {
     let _g = serial();
-    let Some(b) = smol(2048) else { return };
+    let Some(path) = model(SMOL) else { return };
+    let mut cfg = LlamaCppConfig::new(path);
+    cfg.n_ctx = 2048;
+    cfg.fast_forward = true;
+    let b = LlamaCppBackend::new(cfg).unwrap();
     let mut req = ask(
         "Answer with one word.",
         "Is the sky green? Answer yes or no.",
