@@ -157,8 +157,17 @@ fn check_tuples(
     plan: &TypedPlan,
     pose: Pose,
     visited: &[u32],
+    refs: &[u32],
 ) -> Vec<Finding> {
     let mut out = Vec::new();
+    // In a conversation, an object the person refers back to ("the table you just
+    // visited", "where we started") is reached by id or by position.
+    let by_reference = plan.steps.iter().any(|s| {
+        matches!(s, Step::MoveTo(_))
+            || s.objects()
+                .iter()
+                .any(|o| matches!(o, planner_dsl::typed::Object::Instance(_)))
+    });
     let used = plan_labels(map, plan, pose);
     let said = words(instruction).join(" ");
     let said_words = format!(" {said} ");
@@ -217,7 +226,12 @@ fn check_tuples(
             .instances
             .iter()
             .any(|i| visited.contains(&i.id) && i.label == label);
-        if !used.contains(&label) && !reached {
+        let referred = by_reference
+            && refs
+                .iter()
+                .filter_map(|id| map.instance_by_id(*id))
+                .any(|i| i.label == label);
+        if !used.contains(&label) && !reached && !referred {
             out.push(Finding::new(
                 FindingKind::Parts,
                 format!(
@@ -367,6 +381,7 @@ fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32
 /// the instances the plan's dry run stopped at (empty without a dry run): a colour is
 /// accounted for when a target says it or when the plan reaches an instance of it ("the
 /// sofa that isn't black" on a map of one red and one black sofa is "the red sofa").
+/// `refs` are the instances the conversation visited before (empty outside one).
 #[must_use]
 pub fn check_answer(
     map: &IvlMap,
@@ -375,8 +390,9 @@ pub fn check_answer(
     plan: &TypedPlan,
     pose: Pose,
     visited: &[u32],
+    refs: &[u32],
 ) -> Vec<Finding> {
-    let mut out = check_tuples(map, instruction, tuples, plan, pose, visited);
+    let mut out = check_tuples(map, instruction, tuples, plan, pose, visited, refs);
     out.extend(check_words(map, instruction, plan, visited));
     // A plan with no step that moves or turns does nothing the person asked for.
     if !plan
@@ -435,7 +451,7 @@ mod tests {
     fn findings(instruction: &str, answer: &str) -> Vec<Finding> {
         let m = map();
         let a = parse_answer(answer).unwrap();
-        check_answer(&m, instruction, &a.tuples, &a.plan, m.start_pose, &[])
+        check_answer(&m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[])
     }
 
     #[test]
@@ -506,6 +522,35 @@ mod tests {
                 .any(|x| x.kind == FindingKind::Word && x.to_model.contains("grey")),
             "{f:?}"
         );
+    }
+
+    #[test]
+    fn in_a_conversation_an_object_referred_back_to_is_reached_by_id_or_position() {
+        let m = map();
+        let a =
+            parse_answer("objects: [(table, None, None)]\nplan:\nmove_to([4.0, 3.0]);").unwrap();
+        let table = m.instances.iter().find(|i| i.label == "table").unwrap().id;
+        let f = check_answer(
+            &m,
+            "go back to where we started",
+            &a.tuples,
+            &a.plan,
+            m.start_pose,
+            &[],
+            &[table],
+        );
+        assert!(f.is_empty(), "{f:?}");
+        // Outside a conversation the same answer leaves the table unused.
+        let f = check_answer(
+            &m,
+            "go back to where we started",
+            &a.tuples,
+            &a.plan,
+            m.start_pose,
+            &[],
+            &[],
+        );
+        assert_eq!(f.len(), 1, "{f:?}");
     }
 
     #[test]

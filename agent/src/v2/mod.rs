@@ -138,6 +138,7 @@ fn assess(text: &str, instruction: &str, ctx: &PlanContext<'_>) -> Result<Accept
         &answer.plan,
         pose,
         &visited,
+        &ctx.references,
     );
     // The map's own answer first: it says what the map holds.
     if let Some(e) = run_error {
