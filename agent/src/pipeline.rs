@@ -276,28 +276,47 @@ impl Outcome {
     }
 }
 
+/// How many instances labelled `label` have each colour ("unknown colour" for none), in
+/// the order the colours first appear.
+pub(crate) fn colour_counts(map: &IvlMap, label: &str) -> Vec<(String, usize)> {
+    let mut colours: Vec<(String, usize)> = Vec::new();
+    for i in map.instances.iter().filter(|i| i.label == label) {
+        let c = i.colour.clone().unwrap_or_else(|| "unknown colour".into());
+        match colours.iter_mut().find(|(x, _)| *x == c) {
+            Some((_, k)) => *k += 1,
+            None => colours.push((c, 1)),
+        }
+    }
+    colours
+}
+
+/// "2 black, 1 red".
+pub(crate) fn colour_list(colours: &[(String, usize)]) -> String {
+    colours
+        .iter()
+        .map(|(c, k)| format!("{k} {c}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// `label` for one instance, its plural for more.
+pub(crate) fn noun(label: &str, n: usize) -> String {
+    if n == 1 {
+        label.to_string()
+    } else {
+        map_core::matcher::plural(label)
+    }
+}
+
 /// A one-line summary of what the map holds, for prompts: categories with their colours,
 /// then regions. Sorted, so it is the same for every instruction on the scene.
 #[must_use]
 pub fn scene_summary(map: &IvlMap) -> String {
     let mut parts = Vec::new();
     for (label, n) in map.label_counts() {
-        let mut colours: Vec<(String, usize)> = Vec::new();
-        for i in map.instances.iter().filter(|i| i.label == label) {
-            let c = i.colour.clone().unwrap_or_else(|| "unknown colour".into());
-            match colours.iter_mut().find(|(x, _)| *x == c) {
-                Some((_, k)) => *k += 1,
-                None => colours.push((c, 1)),
-            }
-        }
+        let mut colours = colour_counts(map, &label);
         colours.sort();
-        let cs: Vec<String> = colours.iter().map(|(c, k)| format!("{k} {c}")).collect();
-        let noun = if n == 1 {
-            label.clone()
-        } else {
-            map_core::matcher::plural(&label)
-        };
-        parts.push(format!("{noun} ({})", cs.join(", ")));
+        parts.push(format!("{} ({})", noun(&label, n), colour_list(&colours)));
     }
     let mut s = format!("objects: {}", parts.join("; "));
     if !map.regions.is_empty() {

@@ -5,8 +5,7 @@
 //! settle it):
 //! - **words**: the instruction's colour, ordinal and superlative words against the typed
 //!   plan's targets ("third" said, no target with ordinal 3);
-//! - **the two parts**: the objects line against the plan (a tuple's object, colour or
-//!   ordinal that no target carries);
+//! - **the two parts**: the objects line against the plan (an object the plan never uses);
 //! - **the map**: an object the map does not hold, a colour no such object has, and the
 //!   dry run's first error.
 //!
@@ -14,9 +13,10 @@
 //! person.
 
 use map_core::matcher::{canonical, is_colour_word};
-use map_core::{IvlMap, ObjectOrder, Pose, QueryError};
+use map_core::{IvlMap, ObjectOrder, Pose};
 use planner_dsl::typed::{Step, Target, TypedPlan};
 
+use crate::pipeline::{colour_counts, colour_list, noun};
 use crate::tuples::{normalise_colour, parse_ordinal, parse_ordinal_with_order, Tuple};
 use crate::words::words;
 
@@ -49,7 +49,11 @@ pub struct Finding {
 }
 
 impl Finding {
-    fn new(kind: FindingKind, to_model: impl Into<String>, to_user: impl Into<String>) -> Self {
+    pub(crate) fn new(
+        kind: FindingKind,
+        to_model: impl Into<String>,
+        to_user: impl Into<String>,
+    ) -> Self {
         Self {
             kind,
             to_model: to_model.into(),
@@ -82,9 +86,7 @@ fn label_of_typed(map: &IvlMap, name: &str, pose: Pose) -> Option<String> {
     }
     let n = map_core::matcher::singular(&map_core::matcher::normalise(name));
     let limit = if n.chars().count() <= 5 { 1 } else { 2 };
-    let mut names: Vec<String> = map.label_counts().into_iter().map(|(l, _)| l).collect();
-    names.extend(map.regions.iter().map(|r| r.name.clone()));
-    let close: Vec<String> = names
+    let close: Vec<String> = names_on_map(map)
         .into_iter()
         .filter(|l| strsim::damerau_levenshtein(&n, l) <= limit)
         .collect();
@@ -120,29 +122,21 @@ fn plan_labels(map: &IvlMap, plan: &TypedPlan, pose: Pose) -> Vec<String> {
 /// A short list of what the map holds of `label`, for questions: "3 chairs (2 black, 1 red)".
 #[must_use]
 pub fn describe_label(map: &IvlMap, label: &str) -> String {
-    let of: Vec<_> = map.instances.iter().filter(|i| i.label == label).collect();
-    let mut colours: Vec<(String, usize)> = Vec::new();
-    for i in &of {
-        let c = i.colour.clone().unwrap_or_else(|| "unknown colour".into());
-        match colours.iter_mut().find(|(x, _)| *x == c) {
-            Some((_, k)) => *k += 1,
-            None => colours.push((c, 1)),
-        }
-    }
-    let noun = if of.len() == 1 {
-        label.to_string()
-    } else {
-        map_core::matcher::plural(label)
-    };
-    let cs: Vec<String> = colours.iter().map(|(c, k)| format!("{k} {c}")).collect();
-    format!("{} {noun} ({})", of.len(), cs.join(", "))
+    let colours = colour_counts(map, label);
+    let n: usize = colours.iter().map(|(_, k)| k).sum();
+    format!("{n} {} ({})", noun(label, n), colour_list(&colours))
 }
 
-/// The labels the map holds, for a refusal.
-fn map_names(map: &IvlMap) -> String {
+/// The labels the map holds, then its regions.
+fn names_on_map(map: &IvlMap) -> Vec<String> {
     let mut v: Vec<String> = map.label_counts().into_iter().map(|(l, _)| l).collect();
     v.extend(map.regions.iter().map(|r| r.name.clone()));
-    v.join(", ")
+    v
+}
+
+/// The labels and regions the map holds, for a refusal.
+fn map_names(map: &IvlMap) -> String {
+    names_on_map(map).join(", ")
 }
 
 /// The objects line against the map and the plan: an object the person named (a word of
@@ -245,13 +239,10 @@ fn check_tuples(
     out
 }
 
-/// Whether some target satisfies `f`.
-fn any_target(plan: &TypedPlan, f: impl Fn(&Target) -> bool) -> bool {
-    targets(plan).into_iter().any(f)
-}
-
 /// The instruction's words against the plan's targets.
 fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32]) -> Vec<Finding> {
+    let ts = targets(plan);
+    let any_target = |f: &dyn Fn(&Target) -> bool| ts.iter().any(|t| f(t));
     let w = words(instruction);
     let mut out = Vec::new();
     // Words that belong to a name on the map ("red room") are not modifiers.
@@ -276,7 +267,7 @@ fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32
                     .iter()
                     .any(|i| visited.contains(&i.id) && same_colour(i.colour.as_deref(), &c));
                 if !reached
-                    && !any_target(plan, |t| {
+                    && !any_target(&|t| {
                         same_colour(t.colour.as_deref(), &c)
                             || same_colour(t.not_colour.as_deref(), &c)
                     })
@@ -293,7 +284,7 @@ fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32
         // Superlatives of distance.
         if matches!(word.as_str(), "farthest" | "furthest") {
             let directional = directions.contains(&next);
-            if !any_target(plan, |t| {
+            if !any_target(&|t| {
                 t.ordinal == -1
                     || t.order == ObjectOrder::FarToNear
                     || (directional && t.order != ObjectOrder::NearToFar)
@@ -313,9 +304,7 @@ fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32
             _ => None,
         };
         if let Some(o) = size {
-            if !any_target(plan, |t| {
-                t.order == o || (t.order == o.reversed() && t.ordinal == -1)
-            }) {
+            if !any_target(&|t| t.order == o || (t.order == o.reversed() && t.ordinal == -1)) {
                 out.push(Finding::new(
                     FindingKind::Word,
                     format!("the person said \"{word}\", but no object in the plan is counted in the order \"{}\"", o.name()),
@@ -327,7 +316,7 @@ fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32
         // Directional superlatives ("westernmost").
         if let Ok((Some(1), Some(order))) = parse_ordinal_with_order(word) {
             if let Ok(o) = ObjectOrder::parse(&order) {
-                if !any_target(plan, |t| t.order == o || t.order == o.reversed()) {
+                if !any_target(&|t| t.order == o || t.order == o.reversed()) {
                     out.push(Finding::new(
                         FindingKind::Word,
                         format!("the person said \"{word}\", but no object in the plan is counted in the order \"{order}\""),
@@ -354,7 +343,7 @@ fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32
                 if last && word != "last" {
                     continue;
                 }
-                let ok = any_target(plan, |t| {
+                let ok = any_target(&|t| {
                     if last {
                         t.ordinal == -1 || (t.ordinal == 1 && t.order != ObjectOrder::NearToFar)
                     } else {
@@ -421,17 +410,6 @@ pub fn runtime_finding(message: &str, line: Option<&str>) -> Finding {
                 .unwrap_or_default()
         ),
         message.to_string(),
-    )
-}
-
-/// Whether a query error is about the map rather than the plan (the person must choose).
-#[must_use]
-pub fn is_map_question(e: &QueryError) -> bool {
-    matches!(
-        e,
-        QueryError::OrdinalPastCount { .. }
-            | QueryError::NoSuchColour { .. }
-            | QueryError::NotAColour { .. }
     )
 }
 

@@ -112,6 +112,9 @@ pub trait Embedder: Send + Sync {
 pub struct ExampleIndex {
     examples: Vec<WorkedExample>,
     vectors: Vec<Vec<f32>>,
+    /// Word and trigram counts of each example's instruction (the fallback ranking),
+    /// computed once.
+    lexical: Vec<HashMap<String, f32>>,
     embedder: Option<Arc<dyn Embedder>>,
 }
 
@@ -165,6 +168,7 @@ impl ExampleIndex {
     #[must_use]
     pub fn lexical(examples: Vec<WorkedExample>) -> Self {
         Self {
+            lexical: examples.iter().map(|e| lexical(&e.instruction)).collect(),
             examples,
             vectors: Vec::new(),
             embedder: None,
@@ -193,6 +197,7 @@ impl ExampleIndex {
             )));
         }
         Ok(Self {
+            lexical: examples.iter().map(|e| lexical(&e.instruction)).collect(),
             examples,
             vectors,
             embedder: Some(embedder),
@@ -235,10 +240,7 @@ impl ExampleIndex {
 
     fn lexical_scores(&self, instruction: &str) -> Vec<f32> {
         let q = lexical(instruction);
-        self.examples
-            .iter()
-            .map(|e| cosine_sparse(&q, &lexical(&e.instruction)))
-            .collect()
+        self.lexical.iter().map(|e| cosine_sparse(&q, e)).collect()
     }
 }
 

@@ -95,24 +95,22 @@ struct Accepted {
 
 /// Reads, checks and dry-runs one answer.
 fn assess(text: &str, instruction: &str, ctx: &PlanContext<'_>) -> Result<Accepted, Vec<Finding>> {
+    let unreadable = |to_model: String| {
+        vec![Finding::new(
+            FindingKind::Unreadable,
+            to_model,
+            "I could not make a plan of that",
+        )]
+    };
     let answer = parse_answer(text).map_err(|e| {
-        vec![Finding {
-            kind: FindingKind::Unreadable,
-            to_model: format!(
-                "{e}; answer with the objects line, then plan: and one call per line"
-            ),
-            to_user: "I could not make a plan of that".into(),
-        }]
+        unreadable(format!(
+            "{e}; answer with the objects line, then plan: and one call per line"
+        ))
     })?;
     let pose = ctx.pose();
     let script = answer.plan.to_rhai();
-    let plan = Plan::compile(&script).map_err(|e| {
-        vec![Finding {
-            kind: FindingKind::Unreadable,
-            to_model: format!("the plan does not compile: {e}"),
-            to_user: "I could not make a plan of that".into(),
-        }]
-    })?;
+    let plan = Plan::compile(&script)
+        .map_err(|e| unreadable(format!("the plan does not compile: {e}")))?;
     let mut visited = Vec::new();
     let mut run_error = None;
     if ctx.options.dry_run {
@@ -156,11 +154,10 @@ fn assess(text: &str, instruction: &str, ctx: &PlanContext<'_>) -> Result<Accept
 
 /// What the person is told when the findings stand after the re-ask.
 fn settle(findings: &[Finding]) -> Outcome {
-    let unknown: Vec<&Finding> = findings
+    if let Some(f) = findings
         .iter()
-        .filter(|f| f.kind == FindingKind::UnknownObject)
-        .collect();
-    if let Some(f) = unknown.first() {
+        .find(|f| f.kind == FindingKind::UnknownObject)
+    {
         return Outcome::Refusal(format!("I can't do that: {}.", f.to_user));
     }
     let mut seen: Vec<&str> = Vec::new();
@@ -205,7 +202,8 @@ pub fn plan_instruction(
     let mut timing = Timing::default();
     let mut attempts = Vec::new();
     let mut findings = Vec::new();
-    for round in 0..=ctx.options.max_repairs.min(1) {
+    let last_round = ctx.options.max_repairs.min(1);
+    for round in 0..=last_round {
         let mut req = CompletionRequest::new(msgs.clone(), ctx.options.plan_max_tokens);
         req.grammar.clone_from(&grammar);
         req.lark.clone_from(&lark);
@@ -225,6 +223,10 @@ pub fn plan_instruction(
                     attempts,
                     fixes: Vec::new(),
                 })));
+            }
+            Err(f) if round == last_round => {
+                tracing::debug!(round, answer = %c.text, findings = ?f, "answer still disagrees");
+                findings = f;
             }
             Err(f) => {
                 tracing::debug!(round, answer = %c.text, findings = ?f, "answer disagrees; re-asking once");
