@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # One-time setup for a fresh machine; safe to run again (every step checks first).
 #  - apt packages llama.cpp's build needs (cmake, clang, libclang-dev)
+#  - chromium, chromium-driver and a font for the browser test of `ivlmap serve`
 #  - python3 numpy (tests check that numpy reads our .npy layers)
 #  - the local models of design.md into ~/.cache/ivlmap/models (SHA-256 checked)
 # usage: scripts/setup.sh [model ...]   (models as scripts/fetch-models.sh takes them)
@@ -16,6 +17,11 @@ if ! ls /usr/lib/llvm-*/lib/libclang*.so* >/dev/null 2>&1 && ! ls /usr/lib/x86_6
   need_apt+=(libclang-dev)
 fi
 command -v unzip >/dev/null 2>&1 || need_apt+=(unzip)
+# the browser test of `ivlmap serve` (server/tests/browser.rs): Debian's chromium, its
+# WebDriver, and a font for the page's text
+command -v chromium >/dev/null 2>&1 || need_apt+=(chromium)
+command -v chromedriver >/dev/null 2>&1 || need_apt+=(chromium-driver)
+[ -d /usr/share/fonts/truetype/dejavu ] || need_apt+=(fonts-dejavu-core)
 if [ "${#need_apt[@]}" -gt 0 ]; then
   log "installing ${need_apt[*]}"
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"

@@ -127,6 +127,11 @@ pub struct PlanOptions {
     pub pipeline: Pipeline,
     /// v2: worked examples shown per instruction, the most similar to it (default 3).
     pub examples: usize,
+    /// v2: put every worked example in the static prefix instead (right after the
+    /// system message, before the map's summary, which then opens the request), so a
+    /// prefix-caching backend evaluates them once for every map and instruction; no
+    /// retrieval (`examples` is ignored). Default off.
+    pub all_examples: bool,
     /// v2: hold the answer to the grammar of [`crate::v2::grammar::answer_grammar`]
     /// (backends that take GBNF; default on).
     pub answer_grammar: bool,
@@ -162,6 +167,7 @@ impl Default for PlanOptions {
             script_grammar: false,
             pipeline: Pipeline::default(),
             examples: 3,
+            all_examples: false,
             answer_grammar: true,
             llguidance: true,
         }

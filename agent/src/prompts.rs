@@ -468,7 +468,8 @@ impl Prompts {
         })
     }
 
-    /// The one-call request for `instruction` (with a summary of the conversation).
+    /// The one-call request for `instruction` (with a summary of the conversation, and
+    /// the map's summary when it is not in the system message).
     ///
     /// # Errors
     /// [`PromptError::Template`].
@@ -476,10 +477,11 @@ impl Prompts {
         &self,
         instruction: &str,
         history: Option<&str>,
+        scene: Option<&str>,
     ) -> Result<ChatMessage, PromptError> {
         Ok(ChatMessage::user(self.render(
             "v2_request.md.j2",
-            minijinja::context! { instruction => instruction.trim(), history => history },
+            minijinja::context! { instruction => instruction.trim(), history => history, scene => scene },
         )?))
     }
 

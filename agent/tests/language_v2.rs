@@ -287,3 +287,42 @@ fn smollm2_answers_follow_the_grammar_built_from_the_map() {
         }
     }
 }
+
+#[test]
+fn with_all_examples_everything_before_the_request_is_the_same_for_every_map() {
+    let office = {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../examples/scenes/office-b.scene.json"
+        );
+        Arc::new(IvlMap::from_scene(&Scene::from_path(path).unwrap()))
+    };
+    let flat = flat_a();
+    let prompts = Prompts::builtin();
+    let answer = "objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));";
+    let backend = Scripted::new(&[answer, answer]);
+    for (map, instruction) in [
+        (&flat, "go to the chair"),
+        (&office, "go to a chair please"),
+    ] {
+        let robot = SimRobot::new(map.clone());
+        let mut ctx = v2(map, &robot);
+        ctx.options.all_examples = true;
+        let out = plan_instruction(&backend, &prompts, instruction, &ctx).unwrap();
+        assert!(matches!(out, Outcome::Plan(_)), "{out:?}");
+    }
+    let reqs = backend.requests();
+    let (a, b) = (&reqs[0].messages, &reqs[1].messages);
+    let n_examples = prompts.worked_example_list().unwrap().len();
+    // The system message, then every worked example as a request and its answer, then
+    // the request: the map's summary, then the instruction.
+    assert_eq!(a.len(), 1 + 2 * n_examples + 1);
+    assert_eq!(a[..a.len() - 1], b[..b.len() - 1]);
+    let (ra, rb) = (&a[a.len() - 1].content, &b[b.len() - 1].content);
+    assert!(
+        ra.starts_with("The map here: ") && ra.ends_with("> go to the chair"),
+        "{ra}"
+    );
+    assert!(rb.starts_with("The map here: ") && ra != rb, "{rb}");
+    assert!(!a[0].content.contains("The map here"), "{}", a[0].content);
+}

@@ -90,6 +90,8 @@ pub(crate) enum Command {
         #[arg(long, value_enum)]
         baseline: Option<Baseline>,
     },
+    /// Serve the web chat (a page with the live map) and the HTTP API on one address.
+    Serve(Box<ServeArgs>),
     /// Map tools: inspect, render, save.
     Map {
         #[command(subcommand)]
@@ -98,6 +100,38 @@ pub(crate) enum Command {
     /// Navigation under simulated perception noise: reference plans (ivlmap) and the
     /// VLMaps baseline on maps built from corrupted perception, scored on the true scene.
     NoiseStudy(crate::noise_cmd::NoiseStudyArgs),
+}
+
+/// `ivlmap serve`.
+#[derive(Debug, Args)]
+pub(crate) struct ServeArgs {
+    /// Scene file (.scene.json).
+    #[arg(long, required_unless_present = "map", conflicts_with = "map")]
+    pub(crate) scene: Option<PathBuf>,
+    /// A map folder saved by `ivlmap map save`.
+    #[arg(long)]
+    pub(crate) map: Option<PathBuf>,
+    /// Address to listen on; anything but loopback needs --token.
+    #[arg(long, default_value = server::config::DEFAULT_ADDR)]
+    pub(crate) addr: String,
+    /// Every /api request must send `Authorization: Bearer T` (the page asks for it).
+    #[arg(long, env = "IVLMAP_TOKEN", hide_env_values = true)]
+    pub(crate) token: Option<String>,
+    /// Instructions planned at once (default: 1 for llama, which answers one at a
+    /// time, 4 for other backends).
+    #[arg(long)]
+    pub(crate) workers: Option<usize>,
+    /// Sessions idle this many minutes expire.
+    #[arg(long, default_value_t = 30)]
+    pub(crate) session_minutes: u64,
+    /// Most sessions at once.
+    #[arg(long, default_value_t = 256)]
+    pub(crate) max_sessions: usize,
+    #[command(flatten)]
+    pub(crate) backend: BackendArgs,
+    /// Prompt folder (a variant overlaying the built-in templates).
+    #[arg(long)]
+    pub(crate) prompts: Option<PathBuf>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -173,11 +207,15 @@ pub(crate) struct ModelArgs {
     /// llama: CPU threads.
     #[arg(long)]
     pub(crate) threads: Option<u32>,
-    /// Grammar-constrained decoding (llama; an openai server gets the grammar only if it
-    /// takes one): `tuples` holds step 1 to the tuple notation, `script` holds step 2 to
-    /// calls of the function library.
+    /// Grammar-constrained decoding (llama; openai only with --send-grammar): `tuples`
+    /// holds step 1 to the tuple notation, `script` holds step 2 to calls of the function
+    /// library.
     #[arg(long, value_enum, default_value_t = Grammar::Tuples)]
     pub(crate) grammar: Grammar,
+    /// openai: send the --grammar grammars to the server as GBNF in the request's
+    /// `grammar` field (llama-server takes it; most other servers do not).
+    #[arg(long)]
+    pub(crate) send_grammar: bool,
     /// Use step 1's tuples as the model wrote them: no re-ask on missed words and no
     /// reconciliation with the instruction's words (measures the model alone).
     #[arg(long)]
@@ -189,6 +227,10 @@ pub(crate) struct ModelArgs {
     /// v2: worked examples shown per instruction (the most similar to it).
     #[arg(long, default_value_t = 3)]
     pub(crate) examples: usize,
+    /// v2: every worked example in the static, cached prefix (no retrieval; the map's
+    /// summary moves into the request).
+    #[arg(long)]
+    pub(crate) all_examples: bool,
     /// v2, llama: hold the answer with llama.cpp's GBNF sampler instead of llguidance
     /// (slower; for comparison).
     #[arg(long)]
@@ -226,6 +268,7 @@ impl ModelArgs {
             cassette: self.cassette.clone(),
             record: self.record.clone(),
             threads: self.threads,
+            send_grammar: self.send_grammar,
         }
     }
 
@@ -240,6 +283,7 @@ impl ModelArgs {
                 PipelineArg::V2 => agent::Pipeline::V2,
             },
             examples: self.examples,
+            all_examples: self.all_examples,
             llguidance: !self.gbnf,
             answer_grammar: !matches!(self.grammar, Grammar::None),
             ..PlanOptions::default()

@@ -9,10 +9,12 @@ use llm::{LlmBackend, LlmError, Recording, ReplayBackend};
 use llm::{OpenAiBackend, OpenAiConfig};
 
 /// The default local model (fetched by `scripts/fetch-models.sh qwen1.5b`).
+#[cfg(feature = "llama")]
 pub const DEFAULT_MODEL_FILE: &str = "qwen2.5-coder-1.5b-instruct-q4_k_m.gguf";
 
 /// Where the default model lives: `$IVLMAP_MODELS/<file>`, else
 /// `~/.cache/ivlmap/models/<file>`.
+#[cfg(feature = "llama")]
 #[must_use]
 pub fn default_model_path() -> PathBuf {
     // map_core's folder (the ONNX models live there too); with no HOME, relative.
@@ -36,6 +38,9 @@ pub struct BackendChoice {
     pub record: Option<PathBuf>,
     /// llama: CPU threads (default 2).
     pub threads: Option<u32>,
+    /// openai: send each request's GBNF grammar as the `grammar` field (a llama-server
+    /// extension; other servers may ignore or refuse it). Off: the grammar is not sent.
+    pub send_grammar: bool,
 }
 
 /// The backends this binary was built with (cargo features `llama` and `openai`).
@@ -89,6 +94,7 @@ pub fn open_backend(choice: &BackendChoice) -> Result<Box<dyn LlmBackend>, LlmEr
             if let Some(m) = &choice.model {
                 cfg.model = m.clone();
             }
+            cfg.send_grammar = choice.send_grammar;
             Box::new(OpenAiBackend::new(cfg)?)
         }
         "replay" => {

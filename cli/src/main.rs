@@ -15,6 +15,7 @@ mod mapinfo;
 mod mission;
 mod noise_cmd;
 mod retrieval;
+mod serve_cmd;
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -117,6 +118,7 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             )
         }
         Command::Map { command } => commands::map_cmd(command),
+        Command::Serve(args) => serve_cmd::serve(&args, prompts(args.prompts.as_deref())?),
         Command::NoiseStudy(args) => noise_cmd::noise_study_cli(&args).map(|()| ExitCode::SUCCESS),
     }
 }

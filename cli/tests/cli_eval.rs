@@ -1,7 +1,7 @@
 //! `ivlmap eval` with the real binary: suite errors name file, line and field; the
 //! public navigation suites are achievable (reference plans, SR = 1); an extraction
 //! suite recorded from an OpenAI-compatible server (wiremock on 127.0.0.1) replays from
-//! the cassette with the same answers.
+//! the cassette with the same answers; `--send-grammar` sends that server the grammar.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test helpers
 
@@ -220,4 +220,71 @@ fn extraction_suite_recorded_then_replayed_from_a_cassette() {
     assert_eq!(reports.len(), 2, "{out}");
     let acc = out.lines().find(|l| l.starts_with("accuracy")).unwrap();
     assert_eq!(acc.split_whitespace().count(), 3, "{acc}");
+}
+
+#[test]
+fn send_grammar_passes_the_tuple_grammar_to_an_openai_server() {
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    let server = rt.block_on(MockServer::start());
+    rt.block_on(
+        Mock::given(method("POST"))
+            .and(path("/v1/chat/completions"))
+            .respond_with(
+                ResponseTemplate::new(200).set_body_json(completion("[(lamp, 4, purple)]")),
+            )
+            .mount(&server),
+    );
+    let d = tempfile::tempdir().unwrap();
+    let suite = d.path().join("one.extract.jsonl");
+    std::fs::write(
+        &suite,
+        json!({"id": "p1", "instruction": "visit the 4th purple lamp", "expected": [{"object": "lamp", "ordinal": 4, "colour": "purple"}]}).to_string() + "\n",
+    )
+    .unwrap();
+    let base_url = format!("{}/v1", server.uri());
+    let mut grammars = Vec::new();
+    let mut seen = 0;
+    for send in [false, true] {
+        let report = d.path().join(format!("r-{send}.json"));
+        let mut args = vec![
+            "eval",
+            suite.to_str().unwrap(),
+            "--backend",
+            "openai",
+            "--base-url",
+            &base_url,
+            "--report",
+            report.to_str().unwrap(),
+        ];
+        if send {
+            args.push("--send-grammar");
+        }
+        let o = ivlmap(&args);
+        let (out, err) = text(&o);
+        assert!(o.status.success(), "{out}\n{err}");
+        let sent = rt.block_on(server.received_requests()).unwrap_or_default();
+        let bodies: Vec<Value> = sent[seen..]
+            .iter()
+            .map(|r| serde_json::from_slice(&r.body).unwrap())
+            .collect();
+        seen = sent.len();
+        assert!(!bodies.is_empty());
+        grammars.push(
+            bodies
+                .iter()
+                .map(|b| b.get("grammar").cloned())
+                .collect::<Vec<_>>(),
+        );
+    }
+    // Without the flag no request carries a grammar; with it step 1's does (the tuple
+    // grammar of --grammar tuples, the default), as GBNF text.
+    assert!(grammars[0].iter().all(Option::is_none), "{:?}", grammars[0]);
+    let g = grammars[1][0]
+        .as_ref()
+        .and_then(Value::as_str)
+        .unwrap_or_default();
+    assert!(g.contains("root ::="), "{:?}", grammars[1]);
 }

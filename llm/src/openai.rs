@@ -391,9 +391,13 @@ fn error_chain(e: &dyn std::error::Error) -> String {
     s
 }
 
+/// Whether a 400's body refuses the `response_format` we sent: OpenAI-style servers name
+/// the field; llama-server names the schema it cannot turn into a grammar ("... JSON
+/// schema error at #/properties/a: cannot resolve $ref ...",
+/// llm/tests/openai_llama_server.rs).
 fn mentions_response_format(body: &str) -> bool {
     let b = body.to_ascii_lowercase();
-    b.contains("response_format") || b.contains("json_schema")
+    b.contains("response_format") || b.contains("json_schema") || b.contains("json schema")
 }
 
 /// The human message in an error body, whatever the server's dialect: OpenAI
@@ -564,6 +568,19 @@ mod tests {
         assert_eq!(error_message(r#"{"detail":"Not Found"}"#), "Not Found");
         assert_eq!(error_message("Bad Gateway\n"), "Bad Gateway");
         assert_eq!(error_message(""), "(empty body)");
+    }
+
+    #[test]
+    fn schema_refusals_are_recognised() {
+        assert!(mentions_response_format(
+            r#"{"error":{"message":"'response_format' of type 'json_schema' is not supported"}}"#
+        ));
+        assert!(mentions_response_format(
+            r#"{"error":{"code":400,"message":"Unable to generate parser for this template. Automatic parser generation failed: JSON schema error at #/properties/a: cannot resolve $ref #/nope, nope not found","type":"invalid_request_error"}}"#
+        ));
+        assert!(!mentions_response_format(
+            r#"{"error":{"code":400,"message":"request (8223 tokens) exceeds the available context size (2048 tokens), try increasing it","type":"exceed_context_size_error"}}"#
+        ));
     }
 
     #[test]

@@ -172,20 +172,32 @@ struct FormatOnly {
 }
 
 /// One row of `instances.json`.
-#[derive(Debug, Serialize, Deserialize)]
+/// Also the instance part of `GET /api/map` (formats.md), so both stay one shape.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct InstanceRecord {
-    id: u32,
-    label: String,
-    label_id: u32,
-    num_of_same_class: u32,
-    color: Option<String>,
-    area: u64,
-    area_m2: f64,
-    bbox: [u32; 4],
-    bbox_m: [f64; 4],
-    centroid: [f64; 2],
-    contour: Vec<[f64; 2]>,
+pub struct InstanceRecord {
+    /// Instance id.
+    pub id: u32,
+    /// Category name.
+    pub label: String,
+    /// 1-based rank among the same label (west to east, then north to south).
+    pub label_id: u32,
+    /// Instances with the same label.
+    pub num_of_same_class: u32,
+    /// Colour word, if known.
+    pub color: Option<String>,
+    /// Area in cells.
+    pub area: u64,
+    /// Area in square metres.
+    pub area_m2: f64,
+    /// `[col, row, width, height]` in cells.
+    pub bbox: [u32; 4],
+    /// `[xmin, ymin, xmax, ymax]` in metres.
+    pub bbox_m: [f64; 4],
+    /// `[x, y]` in metres.
+    pub centroid: [f64; 2],
+    /// Footprint outline in metres.
+    pub contour: Vec<[f64; 2]>,
 }
 
 fn pts(v: &[[f64; 2]]) -> Vec<Point> {

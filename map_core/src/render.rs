@@ -173,6 +173,22 @@ pub fn render_trajectory_png(
     opts: &RenderOptions,
     path: impl AsRef<Path>,
 ) -> Result<(), RenderError> {
+    let path = path.as_ref();
+    render_trajectory_rgb(map, trajectory, opts)
+        .save_with_format(path, image::ImageFormat::Png)
+        .map_err(|source| RenderError::Write {
+            path: path.to_path_buf(),
+            source,
+        })
+}
+
+/// [`render_rgb`] with a recorded trajectory as the overlay.
+#[must_use]
+pub fn render_trajectory_rgb(
+    map: &IvlMap,
+    trajectory: &Trajectory,
+    opts: &RenderOptions,
+) -> RgbImage {
     let pts: Vec<Point> = trajectory.path.iter().map(|&p| Point::from(p)).collect();
     let stops: Vec<(Pose, String)> = trajectory
         .stops
@@ -185,7 +201,7 @@ pub fn render_trajectory_png(
         stops: &stops,
         final_pose: Some(Pose::new(f[0], f[1], f[2])),
     };
-    render_png(map, &overlay, opts, path)
+    render_rgb(map, &overlay, opts)
 }
 
 /// Render to an RGB image: `cols * scale` by `rows * scale` pixels, plus a legend

@@ -239,8 +239,50 @@ fn check_tuples(
     out
 }
 
+/// The map object a colour word at `i` is said of: the name right after it, past other
+/// colour words ("the dark red sofa"), one or two words long ("coffee table"), if the map
+/// holds it as an object (not a region). Post-noun colours ("the sofa, the red one",
+/// "the chair painted red") have no name after them and are not judged here.
+fn noun_after(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<(String, String)> {
+    let mut j = i + 1;
+    while j < w.len()
+        && j <= i + 3
+        && (is_colour_word(&w[j]) || matches!(w[j].as_str(), "dark" | "light" | "bright" | "pale"))
+    {
+        j += 1;
+    }
+    let one = w.get(j)?;
+    let mut candidates = Vec::new();
+    if let Some(two) = w.get(j + 1) {
+        candidates.push(format!("{one} {two}"));
+    }
+    candidates.push(one.clone());
+    candidates.into_iter().find_map(|n| {
+        let l = label_of(map, &n, pose)?;
+        (!map.regions.iter().any(|r| r.name == l)).then_some((n, l))
+    })
+}
+
+/// The instances the plan names by id (chat references).
+fn plan_instances(plan: &TypedPlan) -> Vec<u32> {
+    plan.steps
+        .iter()
+        .flat_map(Step::objects)
+        .filter_map(|o| match o {
+            planner_dsl::typed::Object::Instance(id) => Some(*id),
+            _ => None,
+        })
+        .collect()
+}
+
 /// The instruction's words against the plan's targets.
-fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32]) -> Vec<Finding> {
+fn check_words(
+    map: &IvlMap,
+    instruction: &str,
+    plan: &TypedPlan,
+    pose: Pose,
+    visited: &[u32],
+) -> Vec<Finding> {
     let ts = targets(plan);
     let any_target = |f: &dyn Fn(&Target) -> bool| ts.iter().any(|t| f(t));
     let w = words(instruction);
@@ -258,15 +300,14 @@ fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32
         // Colours.
         if is_colour_word(word) && !name_words.contains(word) {
             if let Some(c) = normalise_colour(word) {
-                if said.contains(&c) {
-                    continue;
-                }
+                let repeated = said.contains(&c);
                 said.push(c.clone());
                 let reached = map
                     .instances
                     .iter()
                     .any(|i| visited.contains(&i.id) && same_colour(i.colour.as_deref(), &c));
-                if !reached
+                if !repeated
+                    && !reached
                     && !any_target(&|t| {
                         same_colour(t.colour.as_deref(), &c)
                             || same_colour(t.not_colour.as_deref(), &c)
@@ -277,6 +318,33 @@ fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32
                         format!("the person said \"{word}\", but no object in the plan has colour \"{c}\" (or not_colour \"{c}\")"),
                         format!("what is {word}?"),
                     ));
+                    continue;
+                }
+                // The colour on the object it is said of: "the chair next to the black
+                // table" is a black table, not a black chair.
+                if let Some((noun, label)) = noun_after(map, &w, i, pose) {
+                    let of_label =
+                        |t: &Target| label_of(map, &t.name, pose).as_deref() == Some(&label);
+                    let carried = any_target(&|t| {
+                        of_label(t)
+                            && (same_colour(t.colour.as_deref(), &c)
+                                || same_colour(t.not_colour.as_deref(), &c))
+                    });
+                    let reached_here = map.instances.iter().any(|i| {
+                        (visited.contains(&i.id) || plan_instances(plan).contains(&i.id))
+                            && i.label == label
+                            && same_colour(i.colour.as_deref(), &c)
+                    });
+                    if any_target(&of_label) && !carried && !reached_here {
+                        out.push(Finding::new(
+                            FindingKind::Word,
+                            format!("the person said \"{word} {noun}\", but no {label} in the plan has colour \"{c}\": the colour belongs to the {label}"),
+                            format!(
+                                "is it the {noun} that is {word}? there are {}",
+                                describe_label(map, &label)
+                            ),
+                        ));
+                    }
                 }
             }
             continue;
@@ -343,22 +411,51 @@ fn check_words(map: &IvlMap, instruction: &str, plan: &TypedPlan, visited: &[u32
                 if last && word != "last" {
                     continue;
                 }
-                let ok = any_target(&|t| {
+                let counts = |t: &Target| {
                     if last {
                         t.ordinal == -1 || (t.ordinal == 1 && t.order != ObjectOrder::NearToFar)
                     } else {
                         t.ordinal.abs() == k
                     }
-                });
-                if !ok {
+                };
+                let wanted = if last {
+                    "-1 (or 1 counted from the other end)".to_string()
+                } else {
+                    k.to_string()
+                };
+                // The object the count is said of ("the second chair"), when its name
+                // follows: the count must be on a target of that object.
+                let noun = noun_after(map, &w, i, pose);
+                if !any_target(&counts) {
+                    let of = noun
+                        .as_ref()
+                        .map_or("object".to_string(), |(_, l)| l.clone());
+                    // The question names the candidates when the object is known.
+                    let to_user = match &noun {
+                        Some((n, l)) => format!(
+                            "which {n} is the {word}? there are {}",
+                            describe_label(map, l)
+                        ),
+                        None => format!("which one is the {word}?"),
+                    };
                     out.push(Finding::new(
                         FindingKind::Word,
-                        format!(
-                            "the person said \"{prev} {word}\", but no object in the plan has ordinal {}",
-                            if last { "-1 (or 1 counted from the other end)".to_string() } else { k.to_string() }
-                        ),
-                        format!("which one is the {word}?"),
+                        format!("the person said \"{prev} {word}\", but no {of} in the plan has ordinal {wanted}"),
+                        to_user,
                     ));
+                } else if let Some((noun, label)) = noun {
+                    let of_label =
+                        |t: &Target| label_of(map, &t.name, pose).as_deref() == Some(&label);
+                    if any_target(&of_label) && !any_target(&|t| of_label(t) && counts(t)) {
+                        out.push(Finding::new(
+                            FindingKind::Word,
+                            format!("the person said \"{prev} {word} {noun}\", but no {label} in the plan has ordinal {wanted}: the count belongs to the {label}"),
+                            format!(
+                                "which {noun} is the {word}? there are {}",
+                                describe_label(map, &label)
+                            ),
+                        ));
+                    }
                 }
             }
         }
@@ -382,7 +479,7 @@ pub fn check_answer(
     refs: &[u32],
 ) -> Vec<Finding> {
     let mut out = check_tuples(map, instruction, tuples, plan, pose, visited, refs);
-    out.extend(check_words(map, instruction, plan, visited));
+    out.extend(check_words(map, instruction, plan, pose, visited));
     // A plan with no step that moves or turns does nothing the person asked for.
     if !plan
         .steps
@@ -556,6 +653,60 @@ mod tests {
             "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\nturn(90);",
         );
         assert!(f.is_empty(), "{f:?}");
+    }
+
+    #[test]
+    fn a_colour_on_the_wrong_noun_is_found() {
+        // flat-a has a black table and black chairs.
+        let colour = "black";
+        let instruction = format!("go to the chair next to the {colour} table");
+        let wrong = findings(
+            &instruction,
+            &format!("objects: [(chair, None, None), (table, None, {colour})]\nplan:\nmove_to_object(get_obj(\"chair\", #{{colour: \"{colour}\", near: get_obj(\"table\")}}));"),
+        );
+        assert!(
+            wrong.iter().any(|f| f.kind == FindingKind::Word
+                && f.to_model.contains(&format!("\"{colour} table\""))),
+            "{wrong:?}"
+        );
+        let right = findings(
+            &instruction,
+            &format!("objects: [(chair, None, None), (table, None, {colour})]\nplan:\nmove_to_object(get_obj(\"chair\", #{{near: get_obj(\"table\", #{{colour: \"{colour}\"}})}}));"),
+        );
+        assert!(right.is_empty(), "{right:?}");
+        // A colour after its noun is not judged by position.
+        let after = findings(
+            &format!("go to the table, the {colour} one"),
+            &format!("objects: [(table, None, {colour})]\nplan:\nmove_to_object(get_obj(\"table\", #{{colour: \"{colour}\"}}));"),
+        );
+        assert!(after.is_empty(), "{after:?}");
+    }
+
+    #[test]
+    fn an_ordinal_on_the_wrong_noun_is_found() {
+        let wrong = findings(
+            "go to the chair next to the second table",
+            "objects: [(chair, None, None), (table, 2, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, near: get_obj(\"table\")}));",
+        );
+        assert!(
+            wrong
+                .iter()
+                .any(|f| f.to_model.contains("\"the second table\"")
+                    && f.to_model.contains("no table")),
+            "{wrong:?}"
+        );
+        // The question names the candidates.
+        assert!(
+            wrong.iter().any(|f| f
+                .to_user
+                .starts_with("which table is the second? there are 4 tables")),
+            "{wrong:?}"
+        );
+        let right = findings(
+            "go to the chair next to the second table",
+            "objects: [(chair, None, None), (table, 2, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{near: get_obj(\"table\", #{ordinal: 2})}));",
+        );
+        assert!(right.is_empty(), "{right:?}");
     }
 
     #[test]

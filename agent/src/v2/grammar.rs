@@ -144,7 +144,9 @@ impl Writer {
 fn objects_rules(w: &mut Writer, map_colours: &[String]) {
     let mut colours: Vec<String> = COLOUR_WORDS.iter().map(|s| (*s).to_string()).collect();
     colours.extend(map_colours.iter().cloned());
-    w.rule("objects", "\"objects: [\" tuple (\", \" tuple)* \"]\"");
+    // Empty when the person names no object ("turn around", "go back to where we
+    // started").
+    w.rule("objects", "\"objects: [\" (tuple (\", \" tuple)*)? \"]\"");
     w.rule(
         "tuple",
         "\"(\" tword \", \" tordinal \", \" tcolour (\", \" torder)? \")\"",

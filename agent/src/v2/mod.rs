@@ -33,21 +33,30 @@ use self::check::{check_answer, runtime_finding, Finding, FindingKind};
 use self::grammar::{answer_grammar, answer_lark, objects_grammar, objects_lark, Vocabulary};
 
 /// The messages of one request: system (+ scene), the nearest worked examples, the
-/// instruction.
+/// instruction. With `all` every worked example follows the system message instead and
+/// the scene opens the request: everything before the request is then the same for
+/// every map, and a prefix-caching backend evaluates it once.
 fn messages(
     prompts: &Prompts,
     instruction: &str,
     scene: Option<&str>,
     history: Option<&str>,
     k: usize,
+    all: bool,
 ) -> Result<Vec<ChatMessage>, LanguageError> {
     let index = prompts.example_index()?;
-    let mut m = vec![ChatMessage::system(prompts.v2_system(scene)?)];
-    for ex in index.nearest(instruction, k) {
-        m.push(prompts.v2_request(&ex.instruction, ex.history.as_deref())?);
+    let shown: Vec<&examples::WorkedExample> = if all {
+        index.examples().iter().collect()
+    } else {
+        index.nearest(instruction, k)
+    };
+    let (system_scene, request_scene) = if all { (None, scene) } else { (scene, None) };
+    let mut m = vec![ChatMessage::system(prompts.v2_system(system_scene)?)];
+    for ex in shown {
+        m.push(prompts.v2_request(&ex.instruction, ex.history.as_deref(), None)?);
         m.push(ChatMessage::assistant(ex.answer.clone()));
     }
-    m.push(prompts.v2_request(instruction, history)?);
+    m.push(prompts.v2_request(instruction, history, request_scene)?);
     Ok(m)
 }
 
@@ -64,7 +73,14 @@ pub fn extract(
 ) -> Result<(Vec<Tuple>, Timing), LanguageError> {
     let t0 = Instant::now();
     let mut req = CompletionRequest::new(
-        messages(prompts, instruction, None, None, options.examples)?,
+        messages(
+            prompts,
+            instruction,
+            None,
+            None,
+            options.examples,
+            options.all_examples,
+        )?,
         options.extract_max_tokens,
     );
     req.stop = vec!["\n".into()];
@@ -191,6 +207,7 @@ pub fn plan_instruction(
         Some(&scene),
         ctx.history.as_deref(),
         ctx.options.examples,
+        ctx.options.all_examples,
     )?;
     let vocab = {
         let mut v = Vocabulary::for_map(ctx.map);

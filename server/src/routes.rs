@@ -1,0 +1,629 @@
+//! The routes of formats.md's "HTTP API", plus additive ones: `GET /api/info` (scene,
+//! backend, model, queue), `POST /api/sessions/{id}/confirm` and `/cancel` (run or drop
+//! the previewed plan), `POST /api/sessions/{id}/reset` (robot back to the start, history
+//! cleared), and the page's own files.
+
+use std::convert::Infallible;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use agent::{LanguageError, Outcome, PlannedInstruction, Session};
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
+use axum::extract::{DefaultBodyLimit, Path, Request, State};
+use axum::http::{header, HeaderMap, StatusCode};
+use axum::middleware::{self, Next};
+use axum::response::sse::{Event, KeepAlive, Sse};
+use axum::response::{Html, IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use futures_util::stream::{self, Stream, StreamExt};
+use map_core::render::{render_trajectory_rgb, RenderOptions};
+use map_core::{Point, Pose, Robot as _, SimRobot, Trajectory};
+use serde::Deserialize;
+use serde_json::{json, Value};
+use tokio::sync::{broadcast, oneshot};
+
+use crate::app::AppState;
+use crate::error::ApiError;
+use crate::reply::{steps, stretch, InstructionReply, Kind};
+use crate::sessions::{SessionEntry, SessionState};
+
+type St = State<Arc<AppState>>;
+
+/// The router: the page, and `/api` behind the token check and the body limit.
+pub(crate) fn router(state: Arc<AppState>) -> Router {
+    let limit = state.config.body_limit;
+    let api = Router::new()
+        .route("/api/info", get(info))
+        .route("/api/map", get(map))
+        .route("/api/sessions", post(create_session))
+        .route(
+            "/api/sessions/{id}",
+            get(get_session).delete(delete_session),
+        )
+        .route("/api/sessions/{id}/instructions", post(instruction))
+        .route("/api/sessions/{id}/confirm", post(confirm))
+        .route("/api/sessions/{id}/cancel", post(cancel))
+        .route("/api/sessions/{id}/undo", post(undo))
+        .route("/api/sessions/{id}/reset", post(reset))
+        .route("/api/sessions/{id}/events", get(events))
+        .route("/api/sessions/{id}/map.png", get(map_png))
+        .route_layer(middleware::from_fn_with_state(state.clone(), auth));
+    Router::new()
+        .route("/", get(page))
+        .route("/index.html", get(page))
+        .route("/assets/app.js", get(app_js))
+        .route("/assets/app.css", get(app_css))
+        .merge(api)
+        .fallback(not_found)
+        .method_not_allowed_fallback(method_not_allowed)
+        .layer(DefaultBodyLimit::max(limit))
+        .with_state(state)
+}
+
+// ---------------------------------------------------------------------------- page
+
+async fn page() -> Html<&'static str> {
+    Html(crate::page::INDEX_HTML)
+}
+
+async fn app_js() -> Response {
+    (
+        [(header::CONTENT_TYPE, "text/javascript; charset=utf-8")],
+        crate::page::APP_JS,
+    )
+        .into_response()
+}
+
+async fn app_css() -> Response {
+    (
+        [(header::CONTENT_TYPE, "text/css; charset=utf-8")],
+        crate::page::APP_CSS,
+    )
+        .into_response()
+}
+
+async fn not_found() -> ApiError {
+    ApiError::new(
+        StatusCode::NOT_FOUND,
+        "not_found",
+        "no such route (see formats.md, \"HTTP API\")",
+    )
+}
+
+async fn method_not_allowed() -> ApiError {
+    ApiError::new(
+        StatusCode::METHOD_NOT_ALLOWED,
+        "method_not_allowed",
+        "this route does not take that method (see formats.md, \"HTTP API\")",
+    )
+}
+
+// ---------------------------------------------------------------------------- auth
+
+/// Equal in constant time for equal lengths (the token's length is not secret).
+fn same_secret(a: &[u8], b: &[u8]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).fold(0u8, |acc, (x, y)| acc | (x ^ y)) == 0
+}
+
+async fn auth(State(st): St, req: Request, next: Next) -> Response {
+    if let Some(token) = &st.config.token {
+        let given = req
+            .headers()
+            .get(header::AUTHORIZATION)
+            .and_then(|v| v.to_str().ok())
+            .and_then(|v| v.strip_prefix("Bearer "))
+            .map(str::trim);
+        if !given.is_some_and(|g| same_secret(g.as_bytes(), token.as_bytes())) {
+            return ApiError::unauthorized().into_response();
+        }
+    }
+    next.run(req).await
+}
+
+// ---------------------------------------------------------------------------- bodies
+
+fn body(body: Result<Bytes, BytesRejection>, limit: usize) -> Result<Bytes, ApiError> {
+    match body {
+        Ok(b) => Ok(b),
+        Err(r) if r.status() == StatusCode::PAYLOAD_TOO_LARGE => Err(ApiError::too_large(limit)),
+        Err(r) => Err(ApiError::bad_request(format!(
+            "cannot read the request body: {}",
+            r.body_text()
+        ))),
+    }
+}
+
+/// A JSON object into `T` (serde would also take an array for a struct: not here).
+fn parse<T: serde::de::DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
+    let v: Value = serde_json::from_slice(bytes)
+        .map_err(|e| ApiError::bad_request(format!("malformed JSON: {e}")))?;
+    if !v.is_object() {
+        return Err(ApiError::bad_request(
+            "the body must be a JSON object, e.g. {\"text\": \"go to the red sofa\"}",
+        ));
+    }
+    serde_json::from_value(v)
+        .map_err(|e| ApiError::bad_request(format!("the JSON has a wrong or missing field: {e}")))
+}
+
+#[derive(Debug, Deserialize)]
+struct InstructionBody {
+    text: String,
+    #[serde(default)]
+    preview: bool,
+}
+
+// ---------------------------------------------------------------------------- info, map
+
+async fn info(State(st): St) -> Json<Value> {
+    let svc = &st.service;
+    Json(json!({
+        "scene": svc.map.name,
+        "backend": svc.backend.name(),
+        "model": svc.backend.model(),
+        "pipeline": svc.options.pipeline,
+        "prompts": svc.prompts.label(),
+        "queue": st.queue.stats(),
+        "sessions": st.sessions.len(),
+        "limits": {
+            "body_bytes": st.config.body_limit,
+            "max_sessions": st.config.max_sessions,
+            "max_queue": st.config.max_queue,
+            "session_ttl_s": st.config.session_ttl.as_secs(),
+            "request_timeout_s": st.config.request_timeout.as_secs(),
+            "undo_depth": st.config.undo_depth,
+            "max_turns": st.config.max_turns,
+            "max_instruction_chars": st.config.max_instruction_chars,
+        },
+        "version": env!("CARGO_PKG_VERSION"),
+    }))
+}
+
+async fn map(State(st): St) -> Response {
+    // Serialised per request: the map is small (tens of kB) and this keeps no copy.
+    Json(&st.map_json).into_response()
+}
+
+// ---------------------------------------------------------------------------- sessions
+
+fn session(st: &AppState, id: &str) -> Result<Arc<SessionEntry>, ApiError> {
+    st.sessions
+        .get(id)
+        .ok_or_else(|| ApiError::unknown_session(id))
+}
+
+fn session_json(st: &AppState, e: &SessionEntry) -> Value {
+    let s = e.state();
+    json!({
+        "id": e.id,
+        "scene": st.service.map.name,
+        "pose": s.robot.pose().to_array(),
+        "trajectory": s.robot.trajectory(),
+        "turns": s.chat.turns(),
+        "undo": s.undo.len(),
+        "pending": s.pending.as_ref().map(|p| json!({
+            "instruction": p.instruction,
+            "tuples": p.tuples,
+            "script": p.script,
+        })),
+    })
+}
+
+async fn create_session(
+    State(st): St,
+    raw: Result<Bytes, BytesRejection>,
+) -> Result<(StatusCode, Json<Value>), ApiError> {
+    let raw = body(raw, st.config.body_limit)?;
+    if !raw.iter().all(u8::is_ascii_whitespace) {
+        let _: serde_json::Map<String, Value> = parse(&raw)?;
+    }
+    let e = st.sessions.create().map_err(|e| {
+        ApiError::new(
+            StatusCode::SERVICE_UNAVAILABLE,
+            "too_many_sessions",
+            e.to_string(),
+        )
+    })?;
+    let pose = e.state().robot.pose().to_array();
+    Ok((
+        StatusCode::CREATED,
+        Json(json!({
+            "id": e.id,
+            "scene": st.service.map.name,
+            "pose": pose,
+            "backend": st.service.backend.name(),
+            "model": st.service.backend.model(),
+        })),
+    ))
+}
+
+async fn get_session(State(st): St, Path(id): Path<String>) -> Result<Json<Value>, ApiError> {
+    let e = session(&st, &id)?;
+    Ok(Json(session_json(&st, &e)))
+}
+
+async fn delete_session(State(st): St, Path(id): Path<String>) -> Result<StatusCode, ApiError> {
+    if st.sessions.remove(&id) {
+        Ok(StatusCode::NO_CONTENT)
+    } else {
+        Err(ApiError::unknown_session(&id))
+    }
+}
+
+/// Waits for the session's turn (one change at a time), within the request timeout.
+async fn turn<'a>(
+    st: &AppState,
+    e: &'a SessionEntry,
+) -> Result<tokio::sync::MutexGuard<'a, ()>, ApiError> {
+    tokio::time::timeout(st.config.request_timeout, e.turn.lock())
+        .await
+        .map_err(|_| {
+            ApiError::model(
+                "timeout",
+                "the session was busy with another instruction for too long",
+            )
+        })
+}
+
+async fn undo(State(st): St, Path(id): Path<String>) -> Result<Json<Value>, ApiError> {
+    let e = session(&st, &id)?;
+    let _turn = turn(&st, &e).await?;
+    {
+        let mut s = e.state();
+        let Some((robot, chat)) = s.undo.pop_back() else {
+            return Err(ApiError::new(
+                StatusCode::CONFLICT,
+                "nothing_to_undo",
+                "nothing to undo: no instruction has moved the robot yet",
+            ));
+        };
+        s.robot = robot;
+        s.chat = chat;
+        s.pending = None;
+    }
+    Ok(Json(session_json(&st, &e)))
+}
+
+async fn reset(State(st): St, Path(id): Path<String>) -> Result<Json<Value>, ApiError> {
+    let e = session(&st, &id)?;
+    let _turn = turn(&st, &e).await?;
+    *e.state() = SessionState::fresh(&st.service.map);
+    Ok(Json(session_json(&st, &e)))
+}
+
+async fn cancel(State(st): St, Path(id): Path<String>) -> Result<Json<Value>, ApiError> {
+    let e = session(&st, &id)?;
+    let _turn = turn(&st, &e).await?;
+    e.state().pending = None;
+    Ok(Json(session_json(&st, &e)))
+}
+
+// ---------------------------------------------------------------------------- instructions
+
+async fn instruction(
+    State(st): St,
+    Path(id): Path<String>,
+    raw: Result<Bytes, BytesRejection>,
+) -> Result<Json<InstructionReply>, ApiError> {
+    let raw = body(raw, st.config.body_limit)?;
+    let req: InstructionBody = parse(&raw)?;
+    let text = req.text.trim().to_string();
+    if text.is_empty() {
+        return Err(ApiError::bad_request(
+            "`text` is empty: say what the robot should do",
+        ));
+    }
+    let chars = text.chars().count();
+    if chars > st.config.max_instruction_chars {
+        return Err(ApiError::bad_request(format!(
+            "`text` is {chars} characters; at most {} are taken",
+            st.config.max_instruction_chars
+        )));
+    }
+    let e = session(&st, &id)?;
+    let started = Instant::now();
+    let _turn = turn(&st, &e).await?;
+    let request = e.next_request();
+    let result = answer(&st, &e, request, &text, req.preview, started).await;
+    e.touch();
+    finish(&e, request, result).map(Json)
+}
+
+async fn confirm(
+    State(st): St,
+    Path(id): Path<String>,
+) -> Result<Json<InstructionReply>, ApiError> {
+    let e = session(&st, &id)?;
+    let _turn = turn(&st, &e).await?;
+    let Some(planned) = e.state().pending.take() else {
+        return Err(ApiError::new(
+            StatusCode::CONFLICT,
+            "nothing_to_confirm",
+            "no previewed plan waits for confirmation (send an instruction with \"preview\": true first)",
+        ));
+    };
+    let request = e.next_request();
+    let result = execute(&st, &e, request, planned).await;
+    finish(&e, request, result).map(Json)
+}
+
+/// Sends `done` with the reply or the error, and passes the result on.
+fn finish(
+    e: &SessionEntry,
+    request: u64,
+    result: Result<InstructionReply, ApiError>,
+) -> Result<InstructionReply, ApiError> {
+    match &result {
+        Ok(r) => e.emit(
+            "done",
+            request,
+            serde_json::to_value(r).unwrap_or(Value::Null),
+        ),
+        Err(err) => {
+            let mut v = err.body();
+            v["status"] = json!(err.status.as_u16());
+            e.emit("done", request, v);
+        }
+    }
+    result
+}
+
+fn language_error(err: &LanguageError) -> ApiError {
+    match err {
+        LanguageError::Backend(b) => ApiError::model(
+            "model_unavailable",
+            format!("the model could not answer: {b}"),
+        ),
+        LanguageError::Prompt(p) => ApiError::internal(format!("prompt template: {p}")),
+        other => ApiError::model(
+            "no_plan",
+            format!("the model's answer could not be made into a plan: {other}"),
+        ),
+    }
+}
+
+/// Plans `text` on a snapshot of the session through the model queue, then previews or
+/// runs it. The session changes only at the very end, and only when it all worked.
+async fn answer(
+    st: &AppState,
+    e: &Arc<SessionEntry>,
+    request: u64,
+    text: &str,
+    preview: bool,
+    started: Instant,
+) -> Result<InstructionReply, ApiError> {
+    let (robot, chat, turns) = {
+        let s = e.state();
+        (s.robot.clone(), s.chat.clone(), s.chat.turns().len())
+    };
+    if !preview && turns >= st.config.max_turns {
+        return Err(ApiError::new(
+            StatusCode::CONFLICT,
+            "session_full",
+            format!(
+                "this session holds {turns} instructions, the most it keeps: reset it or start a new one"
+            ),
+        ));
+    }
+    let pose = robot.pose().to_array();
+    let stops = robot.trajectory().stops.len();
+    let outcome = plan(st, e, request, robot.clone(), chat, text, started).await?;
+    let planned = match outcome {
+        Outcome::Plan(p) => p,
+        Outcome::Question(q) => {
+            return Ok(InstructionReply::without_plan(
+                text,
+                Kind::Question,
+                q,
+                &st.service.map.name,
+                pose,
+                stops + 1,
+            ))
+        }
+        Outcome::Refusal(r) => {
+            return Ok(InstructionReply::without_plan(
+                text,
+                Kind::Refused,
+                r,
+                &st.service.map.name,
+                pose,
+                stops + 1,
+            ))
+        }
+    };
+    e.emit(
+        "tuples",
+        request,
+        json!({"tuples": planned.tuples, "text": agent::tuples::tuples_paper_form(&planned.tuples)}),
+    );
+    e.emit("script", request, json!({"script": planned.script}));
+    if !preview {
+        return execute(st, e, request, planned).await;
+    }
+    let svc = st.service.clone();
+    let (planned, dry) = tokio::task::spawn_blocking(move || {
+        let dry = planner_dsl::dry_run(&planned.plan, &svc.map, &robot, &svc.limits);
+        (planned, dry)
+    })
+    .await
+    .map_err(|j| ApiError::internal(format!("the dry run failed unexpectedly: {j}")))?;
+    let reply = InstructionReply::ran(&planned, dry.outcome, dry.trajectory, true, pose, stops + 1);
+    e.state().pending = Some(planned);
+    Ok(reply)
+}
+
+/// Sends the plan through the model queue and waits for it (within the request
+/// timeout, counted from `started`). `queued` events tell the position, `planning` when
+/// the model takes it up.
+async fn plan(
+    st: &AppState,
+    e: &Arc<SessionEntry>,
+    request: u64,
+    robot: SimRobot,
+    chat: Session,
+    text: &str,
+    started: Instant,
+) -> Result<Outcome, ApiError> {
+    let (tx, rx) = oneshot::channel::<Result<Outcome, LanguageError>>();
+    let tx = Arc::new(Mutex::new(Some(tx)));
+    let svc = st.service.clone();
+    let text = text.to_string();
+    let job_tx = tx.clone();
+    let job = Box::new(move || {
+        let mut ctx = agent::PlanContext::new(&svc.map).with_robot(&robot);
+        ctx.options = svc.options.clone();
+        let result = chat.plan(svc.backend.as_ref(), &svc.prompts, &text, &ctx);
+        let sender = job_tx.lock().ok().and_then(|mut s| s.take());
+        if let Some(s) = sender {
+            let _ = s.send(result);
+        }
+    });
+    let events = e.events();
+    let position = Box::new(move |p: Option<usize>| {
+        let (name, mut data) = match p {
+            Some(k) => ("queued", json!({"position": k})),
+            None => ("planning", json!({})),
+        };
+        data["request"] = json!(request);
+        let _ = events.send(crate::sessions::ServerEvent { name, data });
+    });
+    let wanted = Box::new(move || {
+        tx.lock()
+            .ok()
+            .is_some_and(|s| s.as_ref().is_some_and(|s| !s.is_closed()))
+    });
+    st.queue
+        .push(job, position, wanted)
+        .map_err(|full| ApiError::new(StatusCode::SERVICE_UNAVAILABLE, "busy", full.to_string()))?;
+    let left = st.config.request_timeout.saturating_sub(started.elapsed());
+    match tokio::time::timeout(left, rx).await {
+        Ok(Ok(Ok(outcome))) => Ok(outcome),
+        Ok(Ok(Err(err))) => Err(language_error(&err)),
+        Ok(Err(_)) => Err(ApiError::internal(
+            "planning failed unexpectedly (see the server log); the session is unchanged",
+        )),
+        Err(_) => Err(ApiError::model(
+            "timeout",
+            format!(
+                "no answer from the model within {} s (queue and planning); the session is unchanged",
+                st.config.request_timeout.as_secs()
+            ),
+        )),
+    }
+}
+
+/// Runs `planned` on a copy of the session's robot and conversation, then puts the
+/// copies in place (the old ones go on the undo stack), and sends a `step` per library
+/// call.
+async fn execute(
+    st: &AppState,
+    e: &Arc<SessionEntry>,
+    request: u64,
+    planned: Box<PlannedInstruction>,
+) -> Result<InstructionReply, ApiError> {
+    let (robot, chat) = {
+        let s = e.state();
+        (s.robot.clone(), s.chat.clone())
+    };
+    let svc = st.service.clone();
+    let before = (robot.clone(), chat.clone());
+    let (planned, robot, chat, run) = tokio::task::spawn_blocking(move || {
+        let (mut robot, mut chat) = (robot, chat);
+        let run = chat.execute(&planned, &svc.map, &mut robot, &svc.limits);
+        (planned, robot, chat, run)
+    })
+    .await
+    .map_err(|j| ApiError::internal(format!("the run failed unexpectedly: {j}")))?;
+    let (old_robot, old_chat) = before;
+    let tr = old_robot.trajectory();
+    let part = stretch(
+        robot.trajectory(),
+        tr.stops.len(),
+        tr.path.len(),
+        tr.length_m,
+    );
+    let first_stop = tr.stops.len() + 1;
+    let pose = robot.pose().to_array();
+    for s in steps(&run.trace, &part, first_stop) {
+        e.emit("step", request, s);
+    }
+    {
+        let mut s = e.state();
+        s.undo.push_back((old_robot, old_chat));
+        while s.undo.len() > st.config.undo_depth {
+            s.undo.pop_front();
+        }
+        s.robot = robot;
+        s.chat = chat;
+        s.pending = None;
+    }
+    Ok(InstructionReply::ran(
+        &planned, run, part, false, pose, first_stop,
+    ))
+}
+
+// ---------------------------------------------------------------------------- events, png
+
+async fn events(
+    State(st): St,
+    Path(id): Path<String>,
+) -> Result<Sse<impl Stream<Item = Result<Event, Infallible>>>, ApiError> {
+    let e = session(&st, &id)?;
+    let rx = e.subscribe();
+    let open = Event::default()
+        .event("open")
+        .data(json!({"session": e.id}).to_string());
+    // The stream holds only the receiver: it ends when the session goes, or when the
+    // server shuts down.
+    drop(e);
+    let closing = st.closing.subscribe();
+    let rest = stream::unfold((rx, closing), |(mut rx, mut closing)| async move {
+        if *closing.borrow() {
+            return None;
+        }
+        let event = tokio::select! {
+            got = rx.recv() => match got {
+                Ok(ev) => Event::default().event(ev.name).data(ev.data.to_string()),
+                Err(broadcast::error::RecvError::Lagged(n)) => {
+                    Event::default().comment(format!("missed {n} event(s)"))
+                }
+                Err(broadcast::error::RecvError::Closed) => return None,
+            },
+            _ = closing.changed() => return None,
+        };
+        Some((Ok(event), (rx, closing)))
+    });
+    let all = stream::once(async move { Ok(open) }).chain(rest);
+    Ok(Sse::new(all).keep_alive(KeepAlive::default()))
+}
+
+/// The map with `trajectory` drawn over it, as PNG bytes.
+fn render(map: &map_core::IvlMap, trajectory: &Trajectory) -> Result<Vec<u8>, String> {
+    let img = render_trajectory_rgb(map, trajectory, &RenderOptions::default());
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png)
+        .map_err(|e| e.to_string())?;
+    Ok(out.into_inner())
+}
+
+async fn map_png(State(st): St, Path(id): Path<String>) -> Result<Response, ApiError> {
+    let e = session(&st, &id)?;
+    let trajectory = e.state().robot.trajectory().clone();
+    let svc = st.service.clone();
+    let png = tokio::task::spawn_blocking(move || render(&svc.map, &trajectory))
+        .await
+        .map_err(|j| ApiError::internal(format!("drawing failed unexpectedly: {j}")))?
+        .map_err(|m| ApiError::internal(format!("cannot encode the PNG: {m}")))?;
+    let mut headers = HeaderMap::new();
+    headers.insert(
+        header::CONTENT_TYPE,
+        header::HeaderValue::from_static("image/png"),
+    );
+    headers.insert(
+        header::CACHE_CONTROL,
+        header::HeaderValue::from_static("no-store"),
+    );
+    Ok((headers, png).into_response())
+}
