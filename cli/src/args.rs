@@ -207,6 +207,13 @@ pub(crate) struct ModelArgs {
     /// llama: CPU threads.
     #[arg(long)]
     pub(crate) threads: Option<u32>,
+    /// llama: folder of the prompt cache on disk (snapshots of long prompt prefixes read
+    /// back by later runs; default ~/.cache/ivlmap/prompt-cache).
+    #[arg(long, conflicts_with = "no_prompt_cache")]
+    pub(crate) prompt_cache: Option<PathBuf>,
+    /// llama: no prompt cache on disk (every run evaluates its prompts from scratch).
+    #[arg(long)]
+    pub(crate) no_prompt_cache: bool,
     /// Grammar-constrained decoding (llama; openai only with --send-grammar): `tuples`
     /// holds step 1 to the tuple notation, `script` holds step 2 to calls of the function
     /// library.
@@ -269,6 +276,13 @@ impl ModelArgs {
             record: self.record.clone(),
             threads: self.threads,
             send_grammar: self.send_grammar,
+            prompt_cache: if self.no_prompt_cache {
+                None
+            } else {
+                self.prompt_cache
+                    .clone()
+                    .or_else(crate::backend::default_prompt_cache_dir)
+            },
         }
     }
 

@@ -41,6 +41,16 @@ pub struct BackendChoice {
     /// openai: send each request's GBNF grammar as the `grammar` field (a llama-server
     /// extension; other servers may ignore or refuse it). Off: the grammar is not sent.
     pub send_grammar: bool,
+    /// llama: the prompt cache's folder on disk (`None`: off).
+    pub prompt_cache: Option<PathBuf>,
+}
+
+/// `~/.cache/ivlmap/prompt-cache` (`None` without a home folder).
+#[must_use]
+pub fn default_prompt_cache_dir() -> Option<PathBuf> {
+    std::env::var_os("HOME")
+        .filter(|h| !h.is_empty())
+        .map(|h| PathBuf::from(h).join(".cache/ivlmap/prompt-cache"))
 }
 
 /// The backends this binary was built with (cargo features `llama` and `openai`).
@@ -74,6 +84,7 @@ pub fn open_backend(choice: &BackendChoice) -> Result<Box<dyn LlmBackend>, LlmEr
             if let Some(t) = choice.threads {
                 cfg.threads = t.max(1);
             }
+            cfg.prompt_cache_dir.clone_from(&choice.prompt_cache);
             Box::new(LlamaCppBackend::new(cfg)?)
         }
         #[cfg(feature = "openai")]

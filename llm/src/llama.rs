@@ -39,6 +39,9 @@ use llama_cpp_2::{ChatTemplateError, LogOptions};
 
 use super::{ChatMessage, Completion, CompletionRequest, FinishReason, LlmBackend, LlmError};
 
+mod disk_cache;
+use self::disk_cache::DiskCache;
+
 /// The template used when a model carries none (llama.cpp's built-in ChatML).
 pub const FALLBACK_CHAT_TEMPLATE: &str = "chatml";
 
@@ -79,6 +82,10 @@ pub struct LlamaCppConfig {
     /// with Qwen 1.5B on the v2 answer, those token boundaries derailed the model
     /// ("move_to_object(choose_object_by)") where sampling gave a correct plan.
     pub fast_forward: bool,
+    /// A folder for the prompt cache on disk ([`disk_cache`](self) below: snapshots of
+    /// long prompt prefixes that a later process reads back instead of evaluating them
+    /// again). `None` (the default): nothing is written.
+    pub prompt_cache_dir: Option<PathBuf>,
 }
 
 impl LlamaCppConfig {
@@ -98,6 +105,7 @@ impl LlamaCppConfig {
             fast_forward: false,
             n_slots: 4,
             ignore_eos: false,
+            prompt_cache_dir: None,
         }
     }
 }
@@ -405,6 +413,13 @@ fn worker_main(cfg: LlamaCppConfig, ready: SyncSender<Result<(), LlmError>>, rx:
         clock: 0,
         cfg: &cfg,
         llg: None,
+        disk: if cfg.prefix_cache {
+            cfg.prompt_cache_dir
+                .as_deref()
+                .and_then(|d| DiskCache::open(d, &cfg.model_path))
+        } else {
+            None
+        },
     };
     if ready.send(Ok(())).is_err() {
         return;
@@ -442,6 +457,8 @@ struct Worker<'m> {
     /// llguidance's grammar compiler for this model's vocabulary, built on the first
     /// request with a Lark grammar (walking the vocabulary once).
     llg: Option<llguidance::ParserFactory>,
+    /// The prompt cache on disk, when configured.
+    disk: Option<DiskCache>,
 }
 
 /// The slot for a prompt and the length of the prefix it already holds: the slot with the
@@ -579,6 +596,97 @@ impl Worker<'_> {
         }
     }
 
+    /// Empties least recently used slots other than `slot` until `need` more cells fit.
+    fn make_room(&mut self, slot: usize, need: usize) {
+        let n_ctx = self.ctx.n_ctx() as usize;
+        loop {
+            let used: usize = self.slots.iter().map(|s| s.tokens.len()).sum();
+            if used + need <= n_ctx {
+                break;
+            }
+            let victim = self
+                .slots
+                .iter()
+                .enumerate()
+                .filter(|(i, s)| *i != slot && !s.tokens.is_empty())
+                .min_by_key(|(_, s)| s.last_used)
+                .map(|(i, _)| i);
+            match victim {
+                Some(v) => self.clear_slot(v),
+                // Nothing else to empty: the caller checked that the request fits n_ctx.
+                None => break,
+            }
+        }
+    }
+
+    /// Reads into `slot` the disk snapshot sharing more of `tokens` than the slot's
+    /// `common` prefix does; returns the new common prefix (`common` when none is read).
+    fn load_from_disk(
+        &mut self,
+        slot: usize,
+        seq: i32,
+        tokens: &[LlamaToken],
+        common: usize,
+    ) -> usize {
+        let Some((kv, n, len)) = self
+            .disk
+            .as_ref()
+            .and_then(|d| d.best(tokens))
+            .filter(|(_, n)| *n > common)
+            .map(|(e, n)| (e.kv.clone(), n, e.tokens.len()))
+        else {
+            return common;
+        };
+        if len >= self.ctx.n_ctx() as usize {
+            return common;
+        }
+        self.clear_slot(slot);
+        self.make_room(slot, len);
+        match self.ctx.state_seq_load_file(&kv, seq, len) {
+            Ok((loaded, _)) if loaded.len() == len => {
+                tracing::debug!(file = %kv.display(), tokens = len, shared = n, "prompt cache: prefix read from disk");
+                if let Some(s) = self.slots.get_mut(slot) {
+                    s.tokens = loaded;
+                }
+                n
+            }
+            other => {
+                tracing::warn!(file = %kv.display(), error = ?other.err(), "prompt cache: llama.cpp would not load this snapshot; deleting it");
+                self.clear_slot(slot);
+                if let Some(d) = self.disk.as_mut() {
+                    d.discard(&kv);
+                }
+                0
+            }
+        }
+    }
+
+    /// Writes the slot's sequence to disk when it holds a long prefix (the one this request
+    /// shares with an earlier one) that no snapshot covers yet.
+    fn save_to_disk(&mut self, slot: usize, seq: i32, tokens: &[LlamaToken]) {
+        let Some(s) = self.slots.get(slot) else {
+            return;
+        };
+        let n = s.tokens.len();
+        let Some(d) = self.disk.as_ref().filter(|d| d.wants(tokens, n)) else {
+            return;
+        };
+        let path = d.next_path();
+        match self.ctx.state_seq_save_file(&path, seq, &s.tokens) {
+            Ok(bytes) => {
+                tracing::debug!(file = %path.display(), tokens = n, bytes, "prompt cache: prefix written to disk");
+                let held = s.tokens.clone();
+                if let Some(d) = self.disk.as_mut() {
+                    d.add(path, &held);
+                }
+            }
+            Err(e) => {
+                tracing::warn!(file = %path.display(), error = %e, "prompt cache: cannot write a snapshot");
+                let _ = std::fs::remove_file(&path);
+            }
+        }
+    }
+
     fn decode(&mut self, batch: &mut LlamaBatch<'_>) -> Result<(), LlmError> {
         self.ctx.decode(batch).map_err(|e| {
             self.reset_cache();
@@ -628,6 +736,7 @@ impl Worker<'_> {
         let seq = i32::try_from(slot).map_err(|_| LlmError::Decode {
             message: format!("slot {slot} does not fit llama.cpp's sequence ids"),
         })?;
+        let common = self.load_from_disk(slot, seq, &tokens, common.min(tokens.len() - 1));
         let mut keep = common.min(tokens.len() - 1);
         let held = self.slots.get(slot).map_or(0, |s| s.tokens.len());
         if keep < held {
@@ -648,30 +757,13 @@ impl Worker<'_> {
         }
         // The slots share one KV buffer of n_ctx cells: make room for the rest of the prompt
         // and the longest answer by emptying least recently used slots.
-        let need = tokens.len() - keep + max_new;
-        loop {
-            let used: usize = self.slots.iter().map(|s| s.tokens.len()).sum();
-            if used + need <= n_ctx {
-                break;
-            }
-            let victim = self
-                .slots
-                .iter()
-                .enumerate()
-                .filter(|(i, s)| *i != slot && !s.tokens.is_empty())
-                .min_by_key(|(_, s)| s.last_used)
-                .map(|(i, _)| i);
-            match victim {
-                Some(v) => self.clear_slot(v),
-                // Cannot happen (the slot holds only `keep` prompt tokens and the prompt plus
-                // answer fit n_ctx), but never loop forever.
-                None => break,
-            }
-        }
+        self.make_room(slot, tokens.len() - keep + max_new);
         // `clear_slot` may have fallen back to emptying everything.
         if self.slots.get(slot).map_or(0, |s| s.tokens.len()) < keep {
             keep = 0;
         }
+        // The slot now holds exactly the prefix this prompt shares with what it held.
+        self.save_to_disk(slot, seq, &tokens);
 
         let t_prompt = Instant::now();
         let n_batch = (self.ctx.n_batch() as usize).max(1);

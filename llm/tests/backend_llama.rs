@@ -142,6 +142,75 @@ fn shared_prefix_is_cached_and_output_matches_a_fresh_backend() {
     );
 }
 
+/// Every `.kv` snapshot under the prompt cache folder `dir`.
+fn snapshots(dir: &std::path::Path) -> Vec<PathBuf> {
+    let mut v = Vec::new();
+    for m in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+        for f in std::fs::read_dir(m.path()).into_iter().flatten().flatten() {
+            if f.path().extension().is_some_and(|x| x == "kv") {
+                v.push(f.path());
+            }
+        }
+    }
+    v
+}
+
+#[test]
+fn a_shared_prefix_is_saved_to_disk_and_a_new_backend_reads_it_back() {
+    let _g = serial();
+    let Some(path) = model(SMOL) else { return };
+    let dir = std::env::temp_dir().join(format!("ivlmap-prompt-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let with_disk = || {
+        let mut cfg = LlamaCppConfig::new(&path);
+        cfg.n_ctx = 4096;
+        cfg.prompt_cache_dir = Some(dir.clone());
+        LlamaCppBackend::new(cfg).unwrap()
+    };
+    let prefix = few_shot_prefix().repeat(2);
+    let a = ask(&prefix, "Instruction: go to the second red chair.", 30);
+    let b = ask(&prefix, "Instruction: face the white counter.", 30);
+    let c = ask(
+        &prefix,
+        "Instruction: stop between the black sofa and the bed.",
+        30,
+    );
+
+    // One process: the first request evaluates the prefix, the second shares it and
+    // writes it.
+    let first = with_disk();
+    first.complete(&a).unwrap();
+    assert!(snapshots(&dir).is_empty(), "one request shares nothing yet");
+    let shared = first.complete(&b).unwrap().cached_prompt_tokens;
+    assert!(shared > 1000, "{shared}");
+    assert_eq!(snapshots(&dir).len(), 1);
+    drop(first);
+
+    // A new process reads the prefix back, and answers as if it had evaluated it.
+    let second = with_disk();
+    let warm = second.complete(&c).unwrap();
+    assert_eq!(warm.cached_prompt_tokens, shared, "{warm:?}");
+    assert_eq!(snapshots(&dir).len(), 1, "nothing new to save");
+    drop(second);
+    let cold = smol(4096).unwrap().complete(&c).unwrap();
+    assert_eq!(cold.cached_prompt_tokens, 0);
+    assert_eq!(
+        warm.text, cold.text,
+        "greedy output must not depend on the disk cache"
+    );
+
+    // A damaged snapshot is not used, and is deleted; the request is answered anyway.
+    let kv = snapshots(&dir).remove(0);
+    std::fs::write(&kv, b"not a llama.cpp state file").unwrap();
+    let third = with_disk();
+    let again = third.complete(&c).unwrap();
+    assert_eq!(again.cached_prompt_tokens, 0);
+    assert_eq!(again.text, cold.text);
+    assert!(!kv.exists(), "the damaged snapshot is deleted");
+    drop(third);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn grammar_forces_the_answer_set() {
     let _g = serial();

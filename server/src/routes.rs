@@ -19,7 +19,7 @@ use axum::routing::{get, post};
 use axum::{Json, Router};
 use futures_util::stream::{self, Stream, StreamExt};
 use map_core::render::{render_trajectory_rgb, RenderOptions};
-use map_core::{Point, Pose, Robot as _, SimRobot, Trajectory};
+use map_core::{Robot as _, SimRobot, Trajectory};
 use serde::Deserialize;
 use serde_json::{json, Value};
 use tokio::sync::{broadcast, oneshot};
