@@ -82,9 +82,10 @@ pub struct LlamaCppConfig {
     /// with Qwen 1.5B on the v2 answer, those token boundaries derailed the model
     /// ("move_to_object(choose_object_by)") where sampling gave a correct plan.
     pub fast_forward: bool,
-    /// A folder for the prompt cache on disk ([`disk_cache`](self) below: snapshots of
-    /// long prompt prefixes that a later process reads back instead of evaluating them
-    /// again). `None` (the default): nothing is written.
+    /// A folder for the prompt cache on disk: snapshots of long prompt prefixes (at least
+    /// 512 tokens shared by two requests) that a later process reads back instead of
+    /// evaluating them again, at most 8 per model. `None` (the default): nothing is
+    /// written.
     pub prompt_cache_dir: Option<PathBuf>,
 }
 

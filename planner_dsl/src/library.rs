@@ -299,10 +299,22 @@ impl<'a> Host<'a> {
                 let a = self.instance(spec, 0, &args[0])?;
                 let b = self.instance(spec, 1, &args[1])?;
                 if a.id == b.id {
+                    // Said to whoever wrote the script (a model, a mission's author): the
+                    // usual cause is "between the two X" written as two equal picks.
+                    let colour = a
+                        .colour
+                        .as_deref()
+                        .map(|c| format!(", #{{colour: \"{c}\"}}"))
+                        .unwrap_or_default();
                     return Err(arg_err(
                         spec,
                         1,
-                        format!("is the same object as `object_a` ({})", record(a)),
+                        format!(
+                            "is the same object as `object_a` ({}); to stop between the two {}s that match, use move_between_the_two(\"{}\"{colour})",
+                            record(a),
+                            a.label,
+                            a.label
+                        ),
                     ));
                 }
                 self.go(between_point(a, b), name, StopTarget::Between([a.id, b.id]))

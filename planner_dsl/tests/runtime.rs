@@ -36,6 +36,28 @@ fn runtime_error_stops_the_plan_and_keeps_what_was_done() {
 }
 
 #[test]
+fn between_one_object_and_itself_names_the_function_for_the_two() {
+    let (map, mut robot) = world("flat-a");
+    let plan = Plan::compile(
+        "let t = agent.get_obj(\"table\", #{colour: \"yellow\"});\nagent.move_in_between(t, t);",
+    )
+    .unwrap();
+    let out = run(&plan, &map, &mut robot, &Limits::default());
+    let e = out.error.expect("the same object twice");
+    assert_eq!(e.kind, RuntimeErrorKind::Argument);
+    assert_eq!(e.span, Span { line: 2, col: 7 });
+    assert!(
+        e.message.starts_with("argument `object_b` is the same object as `object_a` (yellow table")
+            && e.message.ends_with(
+                "; to stop between the two tables that match, use move_between_the_two(\"table\", #{colour: \"yellow\"})"
+            ),
+        "{}",
+        e.message
+    );
+    assert!(robot.trajectory().stops.is_empty());
+}
+
+#[test]
 fn error_inside_a_script_function_points_at_the_inner_call() {
     let (map, mut robot) = world("flat-a");
     let plan =

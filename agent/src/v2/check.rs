@@ -313,9 +313,17 @@ fn check_words(
                             || same_colour(t.not_colour.as_deref(), &c)
                     })
                 {
+                    // Name the object it is said of, when the words say ("the second
+                    // black chair"): the re-ask then points at one selection.
+                    let to_model = match noun_after(map, &w, i, pose) {
+                        Some((noun, label)) => format!(
+                            "the person said \"{word} {noun}\", but no {label} in the plan has colour \"{c}\": write colour: \"{c}\" in that {label}'s selection"
+                        ),
+                        None => format!("the person said \"{word}\", but no object in the plan has colour \"{c}\" (or not_colour \"{c}\")"),
+                    };
                     out.push(Finding::new(
                         FindingKind::Word,
-                        format!("the person said \"{word}\", but no object in the plan has colour \"{c}\" (or not_colour \"{c}\")"),
+                        to_model,
                         format!("what is {word}?"),
                     ));
                     continue;
@@ -653,6 +661,20 @@ mod tests {
             "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\nturn(90);",
         );
         assert!(f.is_empty(), "{f:?}");
+    }
+
+    #[test]
+    fn a_dropped_colour_is_asked_back_on_the_object_it_was_said_of() {
+        let f = findings(
+            "go to the second black chair counting from the north",
+            "objects: [(chair, 2, black, north_to_south)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, order: \"north_to_south\"}));",
+        );
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert_eq!(
+            f[0].to_model,
+            "the person said \"black chair\", but no chair in the plan has colour \"black\": write colour: \"black\" in that chair's selection"
+        );
+        assert_eq!(f[0].to_user, "what is black?");
     }
 
     #[test]
