@@ -72,7 +72,7 @@ impl Trajectory {
     }
 
     /// Append path points (a leading point equal to the current end is skipped).
-    fn extend_path(&mut self, pts: &[Point]) {
+    pub fn extend_path(&mut self, pts: &[Point]) {
         for p in pts {
             let a = [p.x, p.y];
             if let Some(last) = self.path.last() {
