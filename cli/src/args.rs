@@ -53,6 +53,8 @@ pub(crate) enum Command {
         /// Prompt folder (a variant overlaying the built-in templates).
         #[arg(long)]
         prompts: Option<PathBuf>,
+        #[command(flatten)]
+        robot: crate::robot::RobotArgs,
     },
     /// Show the tuples and the script for an instruction; run nothing.
     Plan {

@@ -15,6 +15,7 @@ use crate::chat::{Chat, ChatFlow, CHAT_HELP};
 use crate::error::{write_json, CliError};
 use crate::mapinfo::{inspect_table, load_map, render_map};
 use crate::mission::{load_mission, run_mission};
+use crate::robot::{open_robot, RobotArgs};
 
 pub(crate) fn chat(
     scene: &Path,
@@ -86,6 +87,7 @@ pub(crate) fn run(
     png: Option<PathBuf>,
     choice: &BackendChoice,
     prompts: &Prompts,
+    robot_args: &RobotArgs,
 ) -> Result<ExitCode, CliError> {
     let (mission, header_scene) = load_mission(mission_path)?;
     let scene = scene.or(header_scene).ok_or_else(|| {
@@ -100,11 +102,13 @@ pub(crate) fn run(
     } else {
         None
     };
+    let mut robot = open_robot(robot_args, &map)?;
     let mut out = std::io::stdout();
     let report = run_mission(
         &mission,
         mission_path,
         &map,
+        robot.as_mut(),
         backend.as_deref().map(|b| b as &dyn LlmBackend),
         prompts,
         &mut out,

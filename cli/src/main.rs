@@ -15,6 +15,7 @@ mod mapinfo;
 mod mission;
 mod noise_cmd;
 mod retrieval;
+mod robot;
 mod serve_cmd;
 
 use std::path::Path;
@@ -76,6 +77,7 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             png,
             backend,
             prompts: p,
+            robot,
         } => commands::run(
             &mission,
             scene,
@@ -83,6 +85,7 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             png,
             &backend.choice(),
             &prompts(p.as_deref())?,
+            &robot,
         ),
         Command::Plan {
             instruction,
