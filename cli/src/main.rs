@@ -69,7 +69,8 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             scene,
             backend,
             prompts: p,
-        } => commands::chat(&scene, backend.choice(), prompts(p.as_deref())?),
+            robot,
+        } => commands::chat(&scene, backend.choice(), prompts(p.as_deref())?, &robot),
         Command::Run {
             mission,
             scene,

@@ -45,12 +45,34 @@ fn parse_distro(s: &str) -> Result<RosDistro, String> {
     s.parse()
 }
 
+impl RobotKind {
+    /// Its name on the command line (and in `ivlmap serve`'s API).
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            RobotKind::Sim => "sim",
+            RobotKind::Nav2 => "nav2",
+        }
+    }
+}
+
 /// Open the robot for a run on `map`: a simulator at the map's start pose, or Nav2 at
 /// the robot's pose. Ctrl-C cancels Nav2's active goal (the run then fails, keeping
 /// what was driven).
 pub(crate) fn open_robot(args: &RobotArgs, map: &Arc<IvlMap>) -> Result<Box<dyn Robot>, CliError> {
+    match open_real(args, map)? {
+        Some(real) => Ok(real),
+        None => Ok(Box::new(SimRobot::new(map.clone()))),
+    }
+}
+
+/// The real robot of `args` (connected, Ctrl-C wired to cancel its goal), or `None`
+/// for the simulator.
+pub(crate) fn open_real(
+    args: &RobotArgs,
+    map: &Arc<IvlMap>,
+) -> Result<Option<Box<dyn Robot + Send>>, CliError> {
     match args.robot {
-        RobotKind::Sim => Ok(Box::new(SimRobot::new(map.clone()))),
+        RobotKind::Sim => Ok(None),
         RobotKind::Nav2 => {
             let frames = match &args.frame_config {
                 Some(p) => FrameConfig::load(p).map_err(|e| CliError::Input(e.to_string()))?,
@@ -93,7 +115,7 @@ pub(crate) fn open_robot(args: &RobotArgs, map: &Arc<IvlMap>) -> Result<Box<dyn 
                     }
                 });
             });
-            Ok(Box::new(robot))
+            Ok(Some(Box::new(robot)))
         }
     }
 }

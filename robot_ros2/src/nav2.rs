@@ -518,6 +518,11 @@ impl Robot for Nav2Robot {
         self.pose
     }
 
+    fn current_pose(&mut self) -> Pose {
+        self.refresh_pose();
+        self.pose
+    }
+
     fn move_to(
         &mut self,
         goal: Point,
