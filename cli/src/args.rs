@@ -34,6 +34,8 @@ pub(crate) enum Command {
         /// Prompt folder (a variant overlaying the built-in templates).
         #[arg(long)]
         prompts: Option<PathBuf>,
+        #[command(flatten)]
+        robot: crate::robot::RobotArgs,
     },
     /// Run a mission unattended: a .rhai plan or a list of instructions (one per line, # comments).
     Run {
@@ -53,6 +55,8 @@ pub(crate) enum Command {
         /// Prompt folder (a variant overlaying the built-in templates).
         #[arg(long)]
         prompts: Option<PathBuf>,
+        #[command(flatten)]
+        robot: crate::robot::RobotArgs,
     },
     /// Show the tuples and the script for an instruction; run nothing.
     Plan {
@@ -132,6 +136,11 @@ pub(crate) struct ServeArgs {
     /// Prompt folder (a variant overlaying the built-in templates).
     #[arg(long)]
     pub(crate) prompts: Option<PathBuf>,
+    /// The robot plans run on: `sim` gives every session its own simulator; `nav2` is
+    /// one real robot that one session drives at a time (others preview, and are
+    /// refused with 409 `robot_busy` when they ask it to move).
+    #[command(flatten)]
+    pub(crate) robot: crate::robot::RobotArgs,
 }
 
 #[derive(Debug, Subcommand)]

@@ -1,7 +1,13 @@
 //! The chat loop of `ivlmap chat`: each instruction is planned (tuples and script shown),
-//! executed on the simulated robot (trace and path length shown), and remembered for
-//! follow-ups. Lines starting with `:` are commands. The loop is driven line by line
-//! ([`Chat::handle`]), so the binary can feed it from a terminal editor or a pipe.
+//! executed on the robot (the simulator, or a real one with `--robot nav2`; trace and
+//! path length shown), and remembered for follow-ups. Lines starting with `:` are
+//! commands. The loop is driven line by line ([`Chat::handle`]), so the binary can feed
+//! it from a terminal editor or a pipe.
+//!
+//! Plans are always made and previewed on the simulator: with a real robot, on a
+//! simulator put at the robot's pose just read. Undo on a real robot cannot drive it
+//! back: it forgets the last instruction from the conversation, and the robot stays
+//! where it is (its trajectory keeps what it really drove).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -22,7 +28,8 @@ use llm::LlmBackend;
 pub const CHAT_HELP: &str = "\
 Type an instruction (\"go to the second red chair, then the kitchen\") or a command:
   :preview <instruction>   plan and dry-run it without moving the robot
-  :undo                    undo the last instruction (robot and history)
+  :undo                    undo the last instruction (simulator: robot and history;
+                           a real robot stays where it is, only the history forgets)
   :render FILE.png         draw the map with the trajectory so far
   :save FILE.json          write the trajectory so far (formats.md)
   :where                   where the robot is
@@ -40,12 +47,52 @@ pub enum ChatFlow {
     Quit,
 }
 
+/// The robot a chat drives.
+enum ChatRobot {
+    /// The simulator: undo puts it back.
+    Sim(SimRobot),
+    /// A real robot; `sim` plans and previews from its pose.
+    Real {
+        robot: Box<dyn Robot>,
+        sim: SimRobot,
+    },
+}
+
+impl ChatRobot {
+    fn robot(&self) -> &dyn Robot {
+        match self {
+            ChatRobot::Sim(s) => s,
+            ChatRobot::Real { robot, .. } => robot.as_ref(),
+        }
+    }
+
+    fn robot_mut(&mut self) -> &mut dyn Robot {
+        match self {
+            ChatRobot::Sim(s) => s,
+            ChatRobot::Real { robot, .. } => robot.as_mut(),
+        }
+    }
+
+    /// The simulator to plan and preview on: the chat's own, or one at the real
+    /// robot's pose read now.
+    fn planning_sim(&mut self) -> SimRobot {
+        match self {
+            ChatRobot::Sim(s) => s.clone(),
+            ChatRobot::Real { robot, sim } => {
+                sim.reset_to(robot.current_pose());
+                sim.clone()
+            }
+        }
+    }
+}
+
 /// A chat session on one map.
 pub struct Chat {
     map: Arc<IvlMap>,
-    robot: SimRobot,
+    robot: ChatRobot,
     session: Session,
-    undo: Vec<(SimRobot, Session)>,
+    /// Earlier conversations, with the simulator as it was (none for a real robot).
+    undo: Vec<(Option<SimRobot>, Session)>,
     choice: BackendChoice,
     backend: Option<Box<dyn LlmBackend>>,
     prompts: Prompts,
@@ -68,7 +115,24 @@ impl Chat {
     #[must_use]
     pub fn new(map: Arc<IvlMap>, choice: BackendChoice, prompts: Prompts) -> Chat {
         let robot = SimRobot::new(map.clone());
-        let session = Session::new(robot.pose());
+        Self::on(map, ChatRobot::Sim(robot), choice, prompts)
+    }
+
+    /// A chat driving a real robot (connected); plans and previews stay on the
+    /// simulator, put at the robot's pose.
+    #[must_use]
+    pub fn with_real_robot(
+        map: Arc<IvlMap>,
+        mut real: Box<dyn Robot>,
+        choice: BackendChoice,
+        prompts: Prompts,
+    ) -> Chat {
+        let sim = SimRobot::with_pose(map.clone(), real.current_pose());
+        Self::on(map, ChatRobot::Real { robot: real, sim }, choice, prompts)
+    }
+
+    fn on(map: Arc<IvlMap>, robot: ChatRobot, choice: BackendChoice, prompts: Prompts) -> Chat {
+        let session = Session::new(robot.robot().pose());
         Chat {
             map,
             robot,
@@ -112,7 +176,8 @@ impl Chat {
                 "render" => self.render(arg, out),
                 "save" => self.save(arg, out),
                 "where" => {
-                    let p = self.robot.pose();
+                    let p = self.robot.robot_mut().current_pose();
+                    let robot = self.robot.robot();
                     let region = self
                         .map
                         .region_at(p.position)
@@ -123,8 +188,8 @@ impl Chat {
                         p.position.x,
                         p.position.y,
                         p.heading,
-                        self.robot.trajectory().stops.len(),
-                        self.robot.trajectory().length_m
+                        robot.trajectory().stops.len(),
+                        robot.trajectory().length_m
                     );
                     Ok(())
                 }
@@ -173,15 +238,25 @@ impl Chat {
 
     fn undo(&mut self, out: &mut dyn Write) -> Result<(), CliError> {
         match self.undo.pop() {
-            Some((robot, session)) => {
-                self.robot = robot;
+            Some((sim, session)) => {
                 self.session = session;
-                let p = self.robot.pose();
-                let _ = writeln!(
-                    out,
-                    "undone; back at ({:.2}, {:.2})",
-                    p.position.x, p.position.y
-                );
+                if let (Some(sim), ChatRobot::Sim(robot)) = (sim, &mut self.robot) {
+                    *robot = sim;
+                    let p = robot.pose();
+                    let _ = writeln!(
+                        out,
+                        "undone; back at ({:.2}, {:.2})",
+                        p.position.x, p.position.y
+                    );
+                } else {
+                    let p = self.robot.robot_mut().current_pose();
+                    let _ = writeln!(
+                        out,
+                        "undone: the last instruction is forgotten; the real robot is not \
+                         driven back and stays at ({:.2}, {:.2})",
+                        p.position.x, p.position.y
+                    );
+                }
                 Ok(())
             }
             None => Err(CliError::Input("nothing to undo".into())),
@@ -195,7 +270,7 @@ impl Chat {
             ));
         }
         let path = PathBuf::from(arg);
-        render_map(&self.map, Some(self.robot.trajectory()), &path)?;
+        render_map(&self.map, Some(self.robot.robot().trajectory()), &path)?;
         let _ = writeln!(out, "wrote {}", path.display());
         Ok(())
     }
@@ -206,7 +281,7 @@ impl Chat {
                 ":save needs a file name, e.g. :save trajectory.json".into(),
             ));
         }
-        crate::error::write_json(Path::new(arg), self.robot.trajectory())?;
+        crate::error::write_json(Path::new(arg), self.robot.robot().trajectory())?;
         let _ = writeln!(out, "wrote {arg}");
         Ok(())
     }
@@ -221,7 +296,7 @@ impl Chat {
             return Err(CliError::Input(":preview needs an instruction".into()));
         }
         let map = self.map.clone();
-        let robot = self.robot.clone();
+        let robot = self.robot.planning_sim();
         let prompts = self.prompts.clone();
         let session = self.session.clone();
         let backend = self.backend()?;
@@ -244,7 +319,7 @@ impl Chat {
             let _ = writeln!(out, "  {l}");
         }
         if preview {
-            let dry = dry_run(&planned.plan, &map, &self.robot, &self.limits);
+            let dry = dry_run(&planned.plan, &map, &robot, &self.limits);
             let _ = writeln!(out, "preview (the robot does not move):");
             print_trace(out, &dry.outcome);
             let _ = writeln!(
@@ -258,25 +333,33 @@ impl Chat {
             }
             return Ok(());
         }
-        self.undo.push((self.robot.clone(), self.session.clone()));
-        let before = self.robot.trajectory().length_m;
-        let run = self
-            .session
-            .execute(&planned, &map, &mut self.robot, &self.limits);
+        let kept = match &self.robot {
+            ChatRobot::Sim(s) => Some(s.clone()),
+            ChatRobot::Real { .. } => None,
+        };
+        let real = kept.is_none();
+        self.undo.push((kept, self.session.clone()));
+        let robot = self.robot.robot_mut();
+        let before = robot.trajectory().length_m;
+        let run = self.session.execute(&planned, &map, robot, &self.limits);
         let _ = writeln!(out, "trace:");
         print_trace(out, &run);
-        let p = self.robot.pose();
+        let p = robot.pose();
         let _ = writeln!(
             out,
             "path {:.2} m (total {:.2} m); now at ({:.2}, {:.2}) heading {:.0}°",
-            self.robot.trajectory().length_m - before,
-            self.robot.trajectory().length_m,
+            robot.trajectory().length_m - before,
+            robot.trajectory().length_m,
             p.position.x,
             p.position.y,
             p.heading
         );
         if let Some(e) = run.error {
-            let _ = writeln!(out, "error: {e} (stopped there; :undo to go back)");
+            if real {
+                let _ = writeln!(out, "error: {e} (the robot stopped there)");
+            } else {
+                let _ = writeln!(out, "error: {e} (stopped there; :undo to go back)");
+            }
         }
         Ok(())
     }

@@ -15,20 +15,26 @@ use crate::chat::{Chat, ChatFlow, CHAT_HELP};
 use crate::error::{write_json, CliError};
 use crate::mapinfo::{inspect_table, load_map, render_map};
 use crate::mission::{load_mission, run_mission};
+use crate::robot::{open_real, open_robot, RobotArgs};
 
 pub(crate) fn chat(
     scene: &Path,
     choice: BackendChoice,
     prompts: Prompts,
+    robot_args: &RobotArgs,
 ) -> Result<ExitCode, CliError> {
     let map = Arc::new(load_map(scene)?);
-    let mut chat = Chat::new(map.clone(), choice, prompts);
+    let mut chat = match open_real(robot_args, &map)? {
+        Some(real) => Chat::with_real_robot(map.clone(), real, choice, prompts),
+        None => Chat::new(map.clone(), choice, prompts),
+    };
     let stdout = std::io::stdout();
     if std::io::stdin().is_terminal() {
         println!(
-            "ivlmap chat on {:?} ({} instances). :help for commands.",
+            "ivlmap chat on {:?} ({} instances), robot {}. :help for commands.",
             map.name,
-            map.instances.len()
+            map.instances.len(),
+            robot_args.robot.name()
         );
         let mut editor = rustyline::DefaultEditor::new()
             .map_err(|e| CliError::Failed(format!("cannot start the line editor: {e}")))?;
@@ -86,6 +92,7 @@ pub(crate) fn run(
     png: Option<PathBuf>,
     choice: &BackendChoice,
     prompts: &Prompts,
+    robot_args: &RobotArgs,
 ) -> Result<ExitCode, CliError> {
     let (mission, header_scene) = load_mission(mission_path)?;
     let scene = scene.or(header_scene).ok_or_else(|| {
@@ -100,11 +107,13 @@ pub(crate) fn run(
     } else {
         None
     };
+    let mut robot = open_robot(robot_args, &map)?;
     let mut out = std::io::stdout();
     let report = run_mission(
         &mission,
         mission_path,
         &map,
+        robot.as_mut(),
         backend.as_deref().map(|b| b as &dyn LlmBackend),
         prompts,
         &mut out,

@@ -15,6 +15,7 @@ mod mapinfo;
 mod mission;
 mod noise_cmd;
 mod retrieval;
+mod robot;
 mod serve_cmd;
 
 use std::path::Path;
@@ -68,7 +69,8 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             scene,
             backend,
             prompts: p,
-        } => commands::chat(&scene, backend.choice(), prompts(p.as_deref())?),
+            robot,
+        } => commands::chat(&scene, backend.choice(), prompts(p.as_deref())?, &robot),
         Command::Run {
             mission,
             scene,
@@ -76,6 +78,7 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             png,
             backend,
             prompts: p,
+            robot,
         } => commands::run(
             &mission,
             scene,
@@ -83,6 +86,7 @@ fn dispatch(cmd: Command) -> Result<ExitCode, CliError> {
             png,
             &backend.choice(),
             &prompts(p.as_deref())?,
+            &robot,
         ),
         Command::Plan {
             instruction,

@@ -136,18 +136,19 @@ fn compact(v: &serde_json::Value) -> String {
     }
 }
 
-/// Runs a mission on a simulated robot at the map's start pose, printing what happens.
-/// Instruction lists need `backend`; a failing step stops the mission, keeping what
-/// was done.
+/// Runs a mission on `robot` (the simulator at the map's start pose, or a driver),
+/// printing what happens. Instruction lists need `backend`; candidate plans are
+/// dry-run on a simulator at the robot's pose; a failing step stops the mission,
+/// keeping what was done.
 pub fn run_mission(
     mission: &Mission,
     mission_path: &Path,
     map: &Arc<IvlMap>,
+    robot: &mut dyn Robot,
     backend: Option<&dyn LlmBackend>,
     prompts: &Prompts,
     out: &mut dyn Write,
 ) -> MissionReport {
-    let mut robot = SimRobot::new(map.clone());
     let limits = Limits::default();
     let file = mission_path.display().to_string();
     let error = match mission {
@@ -159,7 +160,7 @@ pub fn run_mission(
                 ))
             }
             Ok(plan) => {
-                let outcome = planner_dsl::run(&plan, map, &mut robot, &limits);
+                let outcome = planner_dsl::run(&plan, map, robot, &limits);
                 print_trace(out, &outcome);
                 outcome.error.map(|e| format!("{file}: {e}"))
             }
@@ -168,7 +169,7 @@ pub fn run_mission(
             None => Some(format!(
                 "{file}: a list of instructions needs an LLM backend"
             )),
-            Some(b) => run_instructions(items, &file, map, b, prompts, &mut robot, &limits, out),
+            Some(b) => run_instructions(items, &file, map, b, prompts, robot, &limits, out),
         },
     };
     let mut trajectory = robot.trajectory().clone();
@@ -194,7 +195,7 @@ fn run_instructions(
     map: &Arc<IvlMap>,
     backend: &dyn LlmBackend,
     prompts: &Prompts,
-    robot: &mut SimRobot,
+    robot: &mut dyn Robot,
     limits: &Limits,
     out: &mut dyn Write,
 ) -> Option<String> {
@@ -203,7 +204,9 @@ fn run_instructions(
     let mut failure = None;
     for (line, instr) in items {
         let _ = writeln!(out, "> {instr}");
-        let ctx = PlanContext::new(map).with_robot(robot);
+        // The dry run is always the simulator's, from where the robot is.
+        let sim = SimRobot::with_pose(map.clone(), robot.pose());
+        let ctx = PlanContext::new(map).with_robot(&sim);
         let outcome = session.plan(backend, prompts, instr, &ctx);
         let planned = match outcome {
             Ok(Outcome::Plan(p)) => p,

@@ -1,6 +1,7 @@
 //! `ivlmap serve`: the web chat and the HTTP API (formats.md, "HTTP API"), served by
 //! the `server` crate on a tokio runtime. The backend opens before the server listens,
-//! so a missing model is reported at once.
+//! so a missing model is reported at once; so is the robot (`--robot nav2` connects
+//! first: one real robot, driven by one session at a time, see `server::robot`).
 
 use std::io::Write as _;
 use std::process::ExitCode;
@@ -9,7 +10,7 @@ use std::time::Duration;
 
 use agent::Prompts;
 use llm::LlmBackend;
-use server::{ServeConfig, ServeError, Server, Service};
+use server::{ServeConfig, ServeError, Server, Service, SharedRobot};
 
 use crate::args::ServeArgs;
 use crate::backend::open_backend;
@@ -40,6 +41,8 @@ pub(crate) fn serve(args: &ServeArgs, prompts: Prompts) -> Result<ExitCode, CliE
     let mut service = Service::new(map.clone(), backend.clone());
     service.prompts = prompts;
     service.options = options;
+    service.robot = crate::robot::open_real(&args.robot, &map)?
+        .map(|r| Arc::new(SharedRobot::new(args.robot.robot.name(), r)));
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()
@@ -52,11 +55,12 @@ pub(crate) fn serve(args: &ServeArgs, prompts: Prompts) -> Result<ExitCode, CliE
             other => CliError::Failed(other.to_string()),
         })?;
         println!(
-            "ivlmap serve: map {:?} ({} instances), backend {} ({}), {workers} worker(s)",
+            "ivlmap serve: map {:?} ({} instances), backend {} ({}), {workers} worker(s), robot {}",
             map.name,
             map.instances.len(),
             backend.name(),
-            backend.model()
+            backend.model(),
+            args.robot.robot.name()
         );
         println!(
             "open {} in a browser (Ctrl-C stops){}",

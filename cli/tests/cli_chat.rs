@@ -5,34 +5,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test helpers
 
 mod support;
-use support::repo;
-
-use std::io::Write;
-use std::process::{Command, Stdio};
-
-fn chat(input: &str, extra: &[&str]) -> (Option<i32>, String, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_ivlmap"))
-        .args(["chat", "--scene", "examples/scenes/flat-a.scene.json"])
-        .args(extra)
-        .current_dir(repo())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(input.as_bytes())
-        .unwrap();
-    let o = child.wait_with_output().unwrap();
-    (
-        o.status.code(),
-        String::from_utf8_lossy(&o.stdout).to_string(),
-        String::from_utf8_lossy(&o.stderr).to_string(),
-    )
-}
+use support::chat;
 
 #[test]
 fn piped_commands_run_without_a_terminal() {

@@ -72,7 +72,7 @@ impl Trajectory {
     }
 
     /// Append path points (a leading point equal to the current end is skipped).
-    fn extend_path(&mut self, pts: &[Point]) {
+    pub fn extend_path(&mut self, pts: &[Point]) {
         for p in pts {
             let a = [p.x, p.y];
             if let Some(last) = self.path.last() {
@@ -136,6 +136,12 @@ pub enum RobotError {
 pub trait Robot {
     /// The current pose.
     fn pose(&self) -> Pose;
+    /// The pose read again from the robot's own sensing where it has any (a real robot
+    /// may have been pushed or driven by hand since its last call); by default, and
+    /// for the simulator, [`Robot::pose`].
+    fn current_pose(&mut self) -> Pose {
+        self.pose()
+    }
     /// Plan to `goal` and follow the path; records a stop aimed at `target`.
     fn move_to(
         &mut self,

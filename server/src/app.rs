@@ -29,6 +29,9 @@ pub struct Service {
     pub options: PlanOptions,
     /// Limits every script runs under.
     pub limits: Limits,
+    /// A real robot that executes plans instead of each session's simulator (one
+    /// session drives it at a time); `None`: every session has its own simulator.
+    pub robot: Option<Arc<crate::robot::SharedRobot>>,
 }
 
 impl std::fmt::Debug for Service {
@@ -38,6 +41,7 @@ impl std::fmt::Debug for Service {
             .field("backend", &self.backend.name())
             .field("model", &self.backend.model())
             .field("pipeline", &self.options.pipeline)
+            .field("robot", &self.robot.as_ref().map(|r| r.kind().to_string()))
             .finish_non_exhaustive()
     }
 }
@@ -53,6 +57,7 @@ impl Service {
             prompts: Prompts::builtin(),
             options: PlanOptions::default(),
             limits: Limits::default(),
+            robot: None,
         }
     }
 }

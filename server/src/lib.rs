@@ -9,6 +9,8 @@
 //! - [`app`]: [`Service`] (map, backend, prompts, options) and [`Server`] (bind, run).
 //! - [`sessions`]: the bounded session store, idle expiry, per-session events.
 //! - [`queue`]: the first-come-first-served model queue with positions.
+//! - [`robot`]: [`SharedRobot`], the one real robot (`--robot nav2`) a session drives
+//!   at a time.
 //! - [`reply`]: the instruction answer and the `step` events of a run.
 //! - [`mapjson`]: `GET /api/map`, the map as the page draws it.
 //! - [`describe`]: words that pick an instance out ("the second yellow table from the west").
@@ -18,6 +20,11 @@
 //! planned and run on copies, which replace the session's robot and history only when
 //! everything worked. A plan that stops part-way is not a failed request: the robot
 //! stays where it stopped (as in `ivlmap chat`), and undo goes back.
+//!
+//! With a real robot ([`Service::robot`]) plans and previews stay on the simulator (at
+//! the robot's pose), execution drives the robot, one session at a time
+//! ([`robot`]); a run on it cannot be taken back, so undo there only forgets the
+//! instruction.
 //!
 //! ```no_run
 //! # async fn demo() -> Result<(), server::ServeError> {
@@ -42,9 +49,11 @@ pub mod mapjson;
 mod page;
 pub mod queue;
 pub mod reply;
+pub mod robot;
 mod routes;
 pub mod sessions;
 
 pub use app::{Server, Service};
 pub use config::ServeConfig;
 pub use error::{ApiError, ServeError};
+pub use robot::SharedRobot;

@@ -2,6 +2,10 @@
 //! backend, model, queue), `POST /api/sessions/{id}/confirm` and `/cancel` (run or drop
 //! the previewed plan), `POST /api/sessions/{id}/reset` (robot back to the start, history
 //! cleared), and the page's own files.
+//!
+//! With a real robot (`--robot nav2`), additively: `robot` in `/api/info` and in a
+//! session, 409 `robot_busy` when another session drives it, and `note` in undo's
+//! answer (the robot is not driven back).
 
 use std::convert::Infallible;
 use std::sync::{Arc, Mutex};
@@ -19,7 +23,7 @@ use axum::routing::{get, post};
 use axum::{Json, Router};
 use futures_util::stream::{self, Stream, StreamExt};
 use map_core::render::{render_trajectory_rgb, RenderOptions};
-use map_core::{Robot as _, SimRobot, Trajectory};
+use map_core::{Pose, Robot as _, SimRobot, Trajectory};
 use serde::Deserialize;
 use serde_json::{json, Value};
 use tokio::sync::{broadcast, oneshot};
@@ -178,6 +182,10 @@ async fn info(State(st): St) -> Json<Value> {
             "max_instruction_chars": st.config.max_instruction_chars,
         },
         "version": env!("CARGO_PKG_VERSION"),
+        "robot": match &svc.robot {
+            None => json!({"kind": "sim", "shared": false}),
+            Some(r) => json!({"kind": r.kind(), "shared": true, "driven": r.driver().is_some()}),
+        },
     }))
 }
 
@@ -194,9 +202,66 @@ fn session(st: &AppState, id: &str) -> Result<Arc<SessionEntry>, ApiError> {
         .ok_or_else(|| ApiError::unknown_session(id))
 }
 
+/// The session's `robot`: which, and with a shared one whether this session drives it
+/// and whether it could.
+fn robot_json(st: &AppState, id: &str) -> Value {
+    match &st.service.robot {
+        None => json!({"kind": "sim", "shared": false}),
+        Some(r) => json!({
+            "kind": r.kind(),
+            "shared": true,
+            "driving": r.driver().as_deref() == Some(id),
+            "free": r.free_for(id, |s| st.sessions.contains(s)),
+        }),
+    }
+}
+
+fn busy(e: &crate::robot::RobotBusy) -> ApiError {
+    ApiError::new(StatusCode::CONFLICT, "robot_busy", e.to_string())
+}
+
+/// 409 `robot_busy` unless session `id` may drive `real` now.
+fn refuse_unless_free(
+    st: &AppState,
+    real: &crate::robot::SharedRobot,
+    id: &str,
+) -> Result<(), ApiError> {
+    if real.free_for(id, |s| st.sessions.contains(s)) {
+        Ok(())
+    } else {
+        Err(busy(&crate::robot::RobotBusy {
+            kind: real.kind().to_string(),
+        }))
+    }
+}
+
+/// The session's record `sim` put at `pose` (the real robot's), its trajectory kept.
+fn at_pose(sim: &SimRobot, pose: Pose, add: Option<&Trajectory>) -> SimRobot {
+    let mut t = sim.trajectory().clone();
+    if let Some(part) = add {
+        t.stops.extend(part.stops.iter().cloned());
+        let pts: Vec<map_core::Point> = part
+            .path
+            .iter()
+            .map(|p| map_core::Point::new(p[0], p[1]))
+            .collect();
+        t.extend_path(&pts);
+        t.length_m += part.length_m;
+        t.script.clone_from(&part.script);
+        t.error.clone_from(&part.error);
+    }
+    t.final_pose = pose.to_array();
+    let mut s = sim.clone();
+    s.reset_to(pose);
+    *s.trajectory_mut() = t;
+    s
+}
+
 fn session_json(st: &AppState, e: &SessionEntry) -> Value {
+    let robot = robot_json(st, &e.id);
     let s = e.state();
     json!({
+        "robot": robot,
         "id": e.id,
         "scene": st.service.map.name,
         "pose": s.robot.pose().to_array(),
@@ -226,10 +291,14 @@ async fn create_session(
             e.to_string(),
         )
     })?;
+    if let Some(real) = &st.service.robot {
+        *e.state() = SessionState::fresh_at(&st.service.map, real.pose());
+    }
     let pose = e.state().robot.pose().to_array();
     Ok((
         StatusCode::CREATED,
         Json(json!({
+            "robot": robot_json(&st, &e.id),
             "id": e.id,
             "scene": st.service.map.name,
             "pose": pose,
@@ -245,6 +314,9 @@ async fn get_session(State(st): St, Path(id): Path<String>) -> Result<Json<Value
 }
 
 async fn delete_session(State(st): St, Path(id): Path<String>) -> Result<StatusCode, ApiError> {
+    if let Some(real) = &st.service.robot {
+        real.release(&id);
+    }
     if st.sessions.remove(&id) {
         Ok(StatusCode::NO_CONTENT)
     } else {
@@ -279,17 +351,28 @@ async fn undo(State(st): St, Path(id): Path<String>) -> Result<Json<Value>, ApiE
                 "nothing to undo: no instruction has moved the robot yet",
             ));
         };
-        s.robot = robot;
+        if st.service.robot.is_none() {
+            s.robot = robot;
+        }
         s.chat = chat;
         s.pending = None;
     }
-    Ok(Json(session_json(&st, &e)))
+    let mut v = session_json(&st, &e);
+    if st.service.robot.is_some() {
+        v["note"] = json!(
+            "the last instruction is forgotten; the real robot is not driven back and stays where it is"
+        );
+    }
+    Ok(Json(v))
 }
 
 async fn reset(State(st): St, Path(id): Path<String>) -> Result<Json<Value>, ApiError> {
     let e = session(&st, &id)?;
     let _turn = turn(&st, &e).await?;
-    *e.state() = SessionState::fresh(&st.service.map);
+    *e.state() = match &st.service.robot {
+        None => SessionState::fresh(&st.service.map),
+        Some(real) => SessionState::fresh_at(&st.service.map, real.pose()),
+    };
     Ok(Json(session_json(&st, &e)))
 }
 
@@ -337,6 +420,10 @@ async fn confirm(
 ) -> Result<Json<InstructionReply>, ApiError> {
     let e = session(&st, &id)?;
     let _turn = turn(&st, &e).await?;
+    if let Some(real) = &st.service.robot {
+        // Refused with the previewed plan kept (a failed request changes nothing).
+        refuse_unless_free(&st, real, &e.id)?;
+    }
     let Some(planned) = e.state().pending.take() else {
         return Err(ApiError::new(
             StatusCode::CONFLICT,
@@ -394,10 +481,18 @@ async fn answer(
     preview: bool,
     started: Instant,
 ) -> Result<InstructionReply, ApiError> {
-    let (robot, chat, turns) = {
+    let (mut robot, chat, turns) = {
         let s = e.state();
         (s.robot.clone(), s.chat.clone(), s.chat.turns().len())
     };
+    if let Some(real) = &st.service.robot {
+        // Refused before the model's time is spent; taken when the plan runs.
+        if !preview {
+            refuse_unless_free(st, real, &e.id)?;
+        }
+        // Plans and previews start from where the real robot is now.
+        robot = at_pose(&robot, real.pose(), None);
+    }
     if !preview && turns >= st.config.max_turns {
         return Err(ApiError::new(
             StatusCode::CONFLICT,
@@ -527,6 +622,9 @@ async fn execute(
         let s = e.state();
         (s.robot.clone(), s.chat.clone())
     };
+    if st.service.robot.is_some() {
+        return execute_real(st, e, request, planned, robot, chat).await;
+    }
     let svc = st.service.clone();
     let before = (robot.clone(), chat.clone());
     let (planned, robot, chat, run) = tokio::task::spawn_blocking(move || {
@@ -546,21 +644,93 @@ async fn execute(
     );
     let first_stop = tr.stops.len() + 1;
     let pose = robot.pose().to_array();
-    for s in steps(&run.trace, &part, first_stop) {
-        e.emit("step", request, s);
-    }
-    {
-        let mut s = e.state();
-        s.undo.push_back((old_robot, old_chat));
-        while s.undo.len() > st.config.undo_depth {
-            s.undo.pop_front();
-        }
-        s.robot = robot;
-        s.chat = chat;
-        s.pending = None;
-    }
+    commit(
+        st,
+        e,
+        request,
+        (&run, &part, first_stop),
+        (old_robot, old_chat),
+        robot,
+        chat,
+    );
     Ok(InstructionReply::ran(
         &planned, run, part, false, pose, first_stop,
+    ))
+}
+
+/// Sends a run's `step` events, then puts its robot and conversation in place, the old
+/// ones on the undo stack.
+fn commit(
+    st: &AppState,
+    e: &SessionEntry,
+    request: u64,
+    (run, part, first_stop): (&planner_dsl::RunOutcome, &Trajectory, usize),
+    old: (SimRobot, Session),
+    robot: SimRobot,
+    chat: Session,
+) {
+    for s in steps(&run.trace, part, first_stop) {
+        e.emit("step", request, s);
+    }
+    let mut s = e.state();
+    s.undo.push_back(old);
+    while s.undo.len() > st.config.undo_depth {
+        s.undo.pop_front();
+    }
+    s.robot = robot;
+    s.chat = chat;
+    s.pending = None;
+}
+
+/// [`execute`] on the shared real robot: taken for this session (409 `robot_busy` when
+/// another drives it), the plan run on it, the stretch it drove added to the session's
+/// record. The undo stack keeps the conversation (undo cannot drive the robot back).
+async fn execute_real(
+    st: &AppState,
+    e: &Arc<SessionEntry>,
+    request: u64,
+    planned: Box<PlannedInstruction>,
+    record: SimRobot,
+    chat: Session,
+) -> Result<InstructionReply, ApiError> {
+    let svc = st.service.clone();
+    let Some(real) = svc.robot.clone() else {
+        return Err(ApiError::internal("no real robot"));
+    };
+    real.claim(&e.id, |s| st.sessions.contains(s))
+        .map_err(|b| busy(&b))?;
+    let old_chat = chat.clone();
+    let (planned, chat, run, part, pose) = tokio::task::spawn_blocking(move || {
+        real.with(|r| {
+            r.current_pose();
+            let t = r.trajectory();
+            let (stops, path, length) = (t.stops.len(), t.path.len(), t.length_m);
+            let mut chat = chat;
+            let run = chat.execute(&planned, &svc.map, r, &svc.limits);
+            let part = stretch(r.trajectory(), stops, path, length);
+            (planned, chat, run, part, r.pose())
+        })
+    })
+    .await
+    .map_err(|j| ApiError::internal(format!("the run failed unexpectedly: {j}")))?;
+    let first_stop = record.trajectory().stops.len() + 1;
+    let updated = at_pose(&record, pose, Some(&part));
+    commit(
+        st,
+        e,
+        request,
+        (&run, &part, first_stop),
+        (record, old_chat),
+        updated,
+        chat,
+    );
+    Ok(InstructionReply::ran(
+        &planned,
+        run,
+        part,
+        false,
+        pose.to_array(),
+        first_stop,
     ))
 }
 

@@ -43,8 +43,14 @@ impl SessionState {
     /// A fresh robot at the map's start pose and an empty conversation.
     #[must_use]
     pub fn fresh(map: &Arc<IvlMap>) -> Self {
+        Self::fresh_at(map, map.start_pose)
+    }
+
+    /// A fresh robot at `pose` (a real robot's) and an empty conversation.
+    #[must_use]
+    pub fn fresh_at(map: &Arc<IvlMap>, pose: map_core::Pose) -> Self {
         use map_core::Robot as _;
-        let robot = SimRobot::new(map.clone());
+        let robot = SimRobot::with_pose(map.clone(), pose);
         let chat = Session::new(robot.pose());
         Self {
             robot,
@@ -195,6 +201,12 @@ impl SessionStore {
             e.touch();
         }
         e
+    }
+
+    /// Whether session `id` is open (without marking it used).
+    #[must_use]
+    pub fn contains(&self, id: &str) -> bool {
+        self.lock().contains_key(id)
     }
 
     /// Removes `id`; whether it was there.
