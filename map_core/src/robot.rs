@@ -164,6 +164,66 @@ pub trait Robot {
 /// Largest distance a single move_forward may ask for, metres.
 pub const MAX_FORWARD_M: f64 = 1000.0;
 
+/// Largest turn or heading a call may give, degrees.
+const MAX_TURN_DEG: f64 = 36_000.0;
+
+/// The checks every [`Robot`] applies to its arguments before moving, so that a
+/// simulator and a driver refuse the same calls with the same errors.
+pub mod args {
+    use super::{Point, RobotError, MAX_FORWARD_M, MAX_TURN_DEG};
+
+    /// `v` itself, or [`RobotError::NotFinite`] naming `what`.
+    pub fn finite(what: &'static str, v: f64) -> Result<f64, RobotError> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(RobotError::NotFinite { what, value: v })
+        }
+    }
+
+    /// A goal with finite coordinates.
+    pub fn goal(goal: Point) -> Result<Point, RobotError> {
+        finite("goal x", goal.x)?;
+        finite("goal y", goal.y)?;
+        Ok(goal)
+    }
+
+    fn degrees(what: &'static str, v: f64) -> Result<f64, RobotError> {
+        finite(what, v)?;
+        if v.abs() > MAX_TURN_DEG {
+            return Err(RobotError::OutOfRange {
+                what,
+                value: v,
+                range: "-36000..36000 degrees",
+            });
+        }
+        Ok(v)
+    }
+
+    /// A relative turn: finite, within +-36000 degrees.
+    pub fn turn(degrees_cw: f64) -> Result<f64, RobotError> {
+        degrees("turn angle", degrees_cw)
+    }
+
+    /// A compass heading: finite, within +-36000 degrees.
+    pub fn heading(heading: f64) -> Result<f64, RobotError> {
+        degrees("heading", heading)
+    }
+
+    /// A forward distance: finite, within +-[`MAX_FORWARD_M`].
+    pub fn forward(metres: f64) -> Result<f64, RobotError> {
+        finite("distance", metres)?;
+        if metres.abs() > MAX_FORWARD_M {
+            return Err(RobotError::OutOfRange {
+                what: "distance",
+                value: metres,
+                range: "-1000..1000 m",
+            });
+        }
+        Ok(metres)
+    }
+}
+
 /// A simulated robot on an [`IvlMap`]: it plans with A* on the obstacles inflated
 /// by its radius, follows the smoothed path exactly, and records the trajectory.
 /// Cloning is cheap (the map and planner are shared), so a dry run can work on a copy.
@@ -241,14 +301,6 @@ impl SimRobot {
             .and_then(|c| self.inflated.get(c).copied())
             .is_some_and(|occ| !occ)
     }
-
-    fn finite(what: &'static str, v: f64) -> Result<f64, RobotError> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(RobotError::NotFinite { what, value: v })
-        }
-    }
 }
 
 impl Robot for SimRobot {
@@ -262,8 +314,7 @@ impl Robot for SimRobot {
         call: &str,
         target: StopTarget,
     ) -> Result<MoveReport, RobotError> {
-        Self::finite("goal x", goal.x)?;
-        Self::finite("goal y", goal.y)?;
+        args::goal(goal)?;
         // A goal outside the map is clamped to its edge, then snapped like any other.
         let b = self.map.frame.bounds();
         let eps = self.map.frame.cell_size * 0.01;
@@ -303,42 +354,21 @@ impl Robot for SimRobot {
     }
 
     fn turn(&mut self, degrees: f64) -> Result<(), RobotError> {
-        Self::finite("turn angle", degrees)?;
-        if degrees.abs() > 36_000.0 {
-            return Err(RobotError::OutOfRange {
-                what: "turn angle",
-                value: degrees,
-                range: "-36000..36000 degrees",
-            });
-        }
+        args::turn(degrees)?;
         self.pose.heading = normalise_heading(self.pose.heading + degrees);
         self.trajectory.final_pose = self.pose.to_array();
         Ok(())
     }
 
     fn turn_absolute(&mut self, heading: f64) -> Result<(), RobotError> {
-        Self::finite("heading", heading)?;
-        if heading.abs() > 36_000.0 {
-            return Err(RobotError::OutOfRange {
-                what: "heading",
-                value: heading,
-                range: "-36000..36000 degrees",
-            });
-        }
+        args::heading(heading)?;
         self.pose.heading = normalise_heading(heading);
         self.trajectory.final_pose = self.pose.to_array();
         Ok(())
     }
 
     fn move_forward(&mut self, metres: f64) -> Result<MoveReport, RobotError> {
-        Self::finite("distance", metres)?;
-        if metres.abs() > MAX_FORWARD_M {
-            return Err(RobotError::OutOfRange {
-                what: "distance",
-                value: metres,
-                range: "-1000..1000 m",
-            });
-        }
+        args::forward(metres)?;
         let dir = if metres >= 0.0 {
             self.pose.forward()
         } else {

@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use map_core::robot::MoveReport;
+use map_core::robot::{args, MoveReport};
 use map_core::{IvlMap, Point, Pose, Robot, RobotError, SimRobot, Stop, StopTarget, Trajectory};
 use ros2_client::action::{ActionClient, ActionClientQosPolicies};
 use ros2_client::action_msgs::{GoalId, GoalStatusEnum};
@@ -343,14 +343,6 @@ impl Nav2Robot {
             tracing::info!("canceling the active Nav2 goal (sent: {sent})");
         }
     }
-
-    fn finite(what: &'static str, v: f64) -> Result<f64, RobotError> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(RobotError::NotFinite { what, value: v })
-        }
-    }
 }
 
 impl Drop for Nav2Robot {
@@ -529,8 +521,7 @@ impl Robot for Nav2Robot {
         call: &str,
         target: StopTarget,
     ) -> Result<MoveReport, RobotError> {
-        Self::finite("goal x", goal.x)?;
-        Self::finite("goal y", goal.y)?;
+        args::goal(goal)?;
         self.refresh_pose();
         // Where the simulator would stop and face, from the robot's real pose.
         let (aim, snapped) = match &mut self.shadow {
@@ -568,14 +559,7 @@ impl Robot for Nav2Robot {
     }
 
     fn turn(&mut self, degrees: f64) -> Result<(), RobotError> {
-        Self::finite("turn angle", degrees)?;
-        if degrees.abs() > 36_000.0 {
-            return Err(RobotError::OutOfRange {
-                what: "turn angle",
-                value: degrees,
-                range: "-36000..36000 degrees",
-            });
-        }
+        args::turn(degrees)?;
         self.refresh_pose();
         let aim = Pose::new(
             self.pose.position.x,
@@ -586,28 +570,14 @@ impl Robot for Nav2Robot {
     }
 
     fn turn_absolute(&mut self, heading: f64) -> Result<(), RobotError> {
-        Self::finite("heading", heading)?;
-        if heading.abs() > 36_000.0 {
-            return Err(RobotError::OutOfRange {
-                what: "heading",
-                value: heading,
-                range: "-36000..36000 degrees",
-            });
-        }
+        args::heading(heading)?;
         self.refresh_pose();
         let aim = Pose::new(self.pose.position.x, self.pose.position.y, heading);
         Ok(self.drive(aim, &describe(aim))?)
     }
 
     fn move_forward(&mut self, metres: f64) -> Result<MoveReport, RobotError> {
-        Self::finite("distance", metres)?;
-        if metres.abs() > map_core::robot::MAX_FORWARD_M {
-            return Err(RobotError::OutOfRange {
-                what: "distance",
-                value: metres,
-                range: "-1000..1000 m",
-            });
-        }
+        args::forward(metres)?;
         self.refresh_pose();
         let start = self.pose;
         let end = start.position.add(start.forward().scale(metres));
