@@ -157,11 +157,23 @@ struct FrameRecord {
     cols: usize,
 }
 
-#[derive(Debug, Serialize, Deserialize)]
+/// A region as `map.json` writes it; also the region part of `GET /api/map`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RegionRecord {
-    name: String,
-    polygon: Vec<[f64; 2]>,
+pub struct RegionRecord {
+    /// Its name.
+    pub name: String,
+    /// Outline in metres.
+    pub polygon: Vec<[f64; 2]>,
+}
+
+impl From<&crate::map::Region> for RegionRecord {
+    fn from(r: &crate::map::Region) -> Self {
+        RegionRecord {
+            name: r.name.clone(),
+            polygon: arrs(r.polygon.vertices()),
+        }
+    }
 }
 
 /// Only the format tag, read before anything else so that a file of another
@@ -352,14 +364,7 @@ impl IvlMap {
             },
             categories: self.categories.clone(),
             colours: self.colours.clone(),
-            regions: self
-                .regions
-                .iter()
-                .map(|r| RegionRecord {
-                    name: r.name.clone(),
-                    polygon: arrs(r.polygon.vertices()),
-                })
-                .collect(),
+            regions: self.regions.iter().map(RegionRecord::from).collect(),
             robot_radius: self.robot_radius,
             start_pose: [
                 self.start_pose.position.x,

@@ -7,7 +7,7 @@
 //! row (row 0 is the north edge): `{"encoding": "row-runs", "rows": [[col, len, col,
 //! len, ...], ...]}`.
 
-use map_core::persist::InstanceRecord;
+use map_core::persist::{InstanceRecord, RegionRecord};
 use map_core::IvlMap;
 use serde::Serialize;
 
@@ -21,15 +21,6 @@ pub struct InstanceJson {
     pub description: Option<String>,
     /// The region its centroid lies in.
     pub region: Option<String>,
-}
-
-/// A named region.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct RegionJson {
-    /// Its name.
-    pub name: String,
-    /// Outline in metres.
-    pub polygon: Vec<[f64; 2]>,
 }
 
 /// Occupied cells as runs per row.
@@ -49,7 +40,7 @@ pub struct MapJson {
     /// The instance table.
     pub instances: Vec<InstanceJson>,
     /// Named regions.
-    pub regions: Vec<RegionJson>,
+    pub regions: Vec<RegionRecord>,
     /// `[cols, rows]`.
     pub size: [usize; 2],
     /// Metres per cell.
@@ -64,10 +55,6 @@ pub struct MapJson {
     pub robot_radius: f64,
     /// Occupied cells.
     pub obstacles: ObstacleRuns,
-}
-
-fn pts(v: &[map_core::Point]) -> Vec<[f64; 2]> {
-    v.iter().map(|p| [p.x, p.y]).collect()
 }
 
 /// The map as the page draws it.
@@ -110,14 +97,7 @@ pub fn map_json(map: &IvlMap) -> MapJson {
     MapJson {
         name: map.name.clone(),
         instances,
-        regions: map
-            .regions
-            .iter()
-            .map(|r| RegionJson {
-                name: r.name.clone(),
-                polygon: pts(r.polygon.vertices()),
-            })
-            .collect(),
+        regions: map.regions.iter().map(RegionRecord::from).collect(),
         size: [map.frame.cols, map.frame.rows],
         cell_size: map.frame.cell_size,
         origin: [map.frame.origin.x, map.frame.origin.y],
