@@ -34,6 +34,11 @@ pins=(
   "numpy==2.4.6"
 )
 pkgs="$here/robot_ros2/tests/ros2"
+# One build at a time: tests that need the venv run in parallel and each call this
+# script; the others wait here, then find it ready.
+mkdir -p "$(dirname "$venv")"
+exec 9>"$venv.lock"
+flock 9
 stamp="$( (printf '%s\n' "${pins[@]}"; cat "$pkgs"/*/CMakeLists.txt "$pkgs"/*/*/*) | sha256sum | cut -c1-16)"
 if [ -f "$venv/.ivlmap-stamp" ] && [ "$(cat "$venv/.ivlmap-stamp")" = "$stamp" ]; then
   echo "$venv"; exit 0

@@ -7,76 +7,34 @@
 //! a default folder on disk.
 //!
 //! Templates and what they receive:
-//! - `system.md.j2`: the framing shared by both steps (no variables).
-//! - `attributes.md.j2`: step 1's task and examples (no variables).
-//! - `extract_request.md.j2`: step 1's user message: `instruction`, `scene`.
-//! - `functions.md.j2`: `functions` (generated from planner_dsl's registry, never copied by
-//!   hand) and `registry` (a list of `{name, signature, doc, example}`).
-//! - `examples.md.j2`, `codegen.md.j2`: step 2's worked examples and rules (no variables).
-//! - `plan_request.md.j2`: step 2's user message: `instruction`, `tuples` (the paper's
-//!   notation), `tuple_list` (structured), `scene` (a one-line summary of the map),
-//!   `history` (a summary of the conversation so far).
-//! - `repair.md.j2`: the repair feedback: `errors` (a list of messages with positions).
+//! - `v2_system.md.j2`: the system message: `functions` (the typed plan's step functions
+//!   and `get_obj`, generated from planner_dsl's registry, never copied by hand).
+//! - `v2_request.md.j2`: the user message (also for each worked example): `instruction`,
+//!   `history` (the session's named references), `scene` (the map's summary, when it is
+//!   not in the system message).
+//! - `v2_reask.md.j2`: the one re-ask, appended to the request: `findings`.
+//! - `worked_examples.txt` (not a template): instruction -> answer pairs.
 //!
-//! Step 1's system message is `system` + `attributes`; step 2's is `system` + `functions` +
-//! `examples` + `codegen`. Both are identical for every instruction, so a backend with
-//! prefix caching reuses them; everything that varies (the scene, the history, the
-//! instruction) is in the final user message.
+//! The system message and the worked examples are identical for every instruction and
+//! every map, so a backend with prefix caching reuses them; everything that varies (the
+//! scene, the history, the instruction) is in the final user message.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use minijinja::value::Serde;
 use minijinja::{Environment, UndefinedBehavior, Value};
-use serde::Serialize;
 
 use llm::ChatMessage;
 
-use crate::tuples::{tuples_paper_form, Tuple};
-
 /// The template files every prompt set has.
-pub const TEMPLATE_NAMES: &[&str] = &[
-    "system.md.j2",
-    "attributes.md.j2",
-    "extract_request.md.j2",
-    "functions.md.j2",
-    "examples.md.j2",
-    "codegen.md.j2",
-    "plan_request.md.j2",
-    "repair.md.j2",
-    "v2_system.md.j2",
-    "v2_request.md.j2",
-    "v2_reask.md.j2",
-];
+pub const TEMPLATE_NAMES: &[&str] = &["v2_system.md.j2", "v2_request.md.j2", "v2_reask.md.j2"];
 
 /// The worked examples of the one-call answer (not a template: `> instruction` lines each
 /// followed by its answer; see [`crate::v2::examples`]). A variant folder may hold its own.
 pub const WORKED_EXAMPLES: &str = "worked_examples.txt";
 
 const BUILTIN: &[(&str, &str)] = &[
-    ("system.md.j2", include_str!("../../prompts/system.md.j2")),
-    (
-        "attributes.md.j2",
-        include_str!("../../prompts/attributes.md.j2"),
-    ),
-    (
-        "extract_request.md.j2",
-        include_str!("../../prompts/extract_request.md.j2"),
-    ),
-    (
-        "functions.md.j2",
-        include_str!("../../prompts/functions.md.j2"),
-    ),
-    (
-        "examples.md.j2",
-        include_str!("../../prompts/examples.md.j2"),
-    ),
-    ("codegen.md.j2", include_str!("../../prompts/codegen.md.j2")),
-    (
-        "plan_request.md.j2",
-        include_str!("../../prompts/plan_request.md.j2"),
-    ),
-    ("repair.md.j2", include_str!("../../prompts/repair.md.j2")),
     (
         "v2_system.md.j2",
         include_str!("../../prompts/v2_system.md.j2"),
@@ -146,14 +104,6 @@ impl Default for Prompts {
 }
 
 /// One function of the library as templates see it.
-#[derive(Debug, Clone, Serialize)]
-struct FnView {
-    name: &'static str,
-    signature: String,
-    doc: &'static str,
-    example: &'static str,
-}
-
 impl Prompts {
     /// The default templates compiled into the crate (the repository's `prompts/`).
     #[must_use]
@@ -305,97 +255,6 @@ impl Prompts {
         Ok(out.trim_end().to_string())
     }
 
-    fn functions_ctx() -> Value {
-        let registry: Vec<FnView> = planner_dsl::registry()
-            .iter()
-            .map(|f| FnView {
-                name: f.name,
-                signature: f.signature(),
-                doc: f.doc,
-                example: f.example,
-            })
-            .collect();
-        minijinja::context! {
-            functions => planner_dsl::function_list_for_prompt().trim_end(),
-            registry => Value::from(Serde(&registry)),
-        }
-    }
-
-    /// Step 1's system message: `system` + `attributes` (identical for every instruction).
-    ///
-    /// # Errors
-    /// [`PromptError::Template`].
-    pub fn extract_system(&self) -> Result<String, PromptError> {
-        let empty = minijinja::context! {};
-        Ok(format!(
-            "{}\n\n{}",
-            self.render("system.md.j2", empty.clone())?,
-            self.render("attributes.md.j2", empty)?
-        ))
-    }
-
-    /// Step 1's messages for `instruction`.
-    ///
-    /// # Errors
-    /// [`PromptError::Template`].
-    pub fn extract_messages(
-        &self,
-        instruction: &str,
-        scene: Option<&str>,
-    ) -> Result<Vec<ChatMessage>, PromptError> {
-        let user = self.render(
-            "extract_request.md.j2",
-            minijinja::context! { instruction => instruction.trim(), scene => scene },
-        )?;
-        Ok(vec![
-            ChatMessage::system(self.extract_system()?),
-            ChatMessage::user(user),
-        ])
-    }
-
-    /// Step 2's system message: `system` + `functions` + `examples` + `codegen`.
-    ///
-    /// # Errors
-    /// [`PromptError::Template`].
-    pub fn plan_system(&self) -> Result<String, PromptError> {
-        let empty = minijinja::context! {};
-        Ok(format!(
-            "{}\n\n{}\n\n{}\n\n{}",
-            self.render("system.md.j2", empty.clone())?,
-            self.render("functions.md.j2", Self::functions_ctx())?,
-            self.render("examples.md.j2", empty.clone())?,
-            self.render("codegen.md.j2", empty)?
-        ))
-    }
-
-    /// Step 2's messages: the shared system message, then one user message with the scene,
-    /// the conversation summary, the instruction and its tuples.
-    ///
-    /// # Errors
-    /// [`PromptError::Template`].
-    pub fn plan_messages(
-        &self,
-        instruction: &str,
-        tuples: &[Tuple],
-        scene: Option<&str>,
-        history: Option<&str>,
-    ) -> Result<Vec<ChatMessage>, PromptError> {
-        let user = self.render(
-            "plan_request.md.j2",
-            minijinja::context! {
-                instruction => instruction.trim(),
-                tuples => tuples_paper_form(tuples),
-                tuple_list => Value::from(Serde(tuples)),
-                scene => scene,
-                history => history,
-            },
-        )?;
-        Ok(vec![
-            ChatMessage::system(self.plan_system()?),
-            ChatMessage::user(user),
-        ])
-    }
-
     /// The worked examples, read.
     ///
     /// # Errors
@@ -495,17 +354,6 @@ impl Prompts {
             minijinja::context! { findings => Value::from(Serde(findings)) },
         )?))
     }
-
-    /// The user message that sends errors back to the model.
-    ///
-    /// # Errors
-    /// [`PromptError::Template`].
-    pub fn repair_message(&self, errors: &[String]) -> Result<ChatMessage, PromptError> {
-        Ok(ChatMessage::user(self.render(
-            "repair.md.j2",
-            minijinja::context! { errors => Value::from(Serde(errors)) },
-        )?))
-    }
 }
 
 #[cfg(test)]
@@ -518,44 +366,36 @@ mod tests {
         for n in TEMPLATE_NAMES {
             assert!(p.source(n).is_some(), "{n}");
         }
-        let sys = p.plan_system().unwrap();
-        for f in planner_dsl::registry() {
-            assert!(
-                sys.contains(&format!("agent.{}(", f.name)),
-                "{} missing",
-                f.name
-            );
+        let sys = p.v2_system(Some("objects: sofa (1 red)")).unwrap();
+        for f in planner_dsl::typed::STEP_FUNCTIONS {
+            let f = planner_dsl::lookup(f).unwrap();
+            assert!(sys.contains(&f.signature()), "{} missing", f.name);
         }
+        assert!(
+            sys.ends_with("The map here: objects: sofa (1 red)."),
+            "{sys}"
+        );
         let m = p
-            .plan_messages(
-                "go to the red sofa",
-                &[Tuple::new("sofa", None, Some("red"))],
-                Some("1 sofa (red)"),
-                None,
-            )
+            .v2_request("go to the red sofa", Some("visited so far: sofa 2"), None)
             .unwrap();
+        assert!(m.content.contains("go to the red sofa"), "{}", m.content);
         assert!(
-            m[1].content.contains("Objects: [(sofa, None, red)]"),
-            "{}",
-            m[1].content
-        );
-        assert!(
-            m[1].content.starts_with("Map: 1 sofa (red)"),
-            "{}",
-            m[1].content
-        );
-        assert!(!m[1].content.contains("Earlier"), "{}", m[1].content);
-    }
-
-    #[test]
-    fn repair_lists_errors() {
-        let m = Prompts::builtin()
-            .repair_message(&["line 1, column 5: boom".into(), "x".into()])
-            .unwrap();
-        assert!(
-            m.content.contains("- line 1, column 5: boom\n- x"),
+            m.content.contains("visited so far: sofa 2"),
             "{}",
             m.content
         );
+    }
+
+    #[test]
+    fn reask_lists_findings() {
+        let m = Prompts::builtin()
+            .v2_reask(&["the plan visits no table".into(), "x".into()])
+            .unwrap();
+        assert!(
+            m.content.contains("the plan visits no table"),
+            "{}",
+            m.content
+        );
+        assert!(m.content.contains("x"), "{}", m.content);
     }
 }

@@ -2,7 +2,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use agent::prompts::TEMPLATE_NAMES;
-use agent::{PromptError, Prompts, Tuple};
+use agent::{PromptError, Prompts};
 
 fn repo_prompts() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../prompts")
@@ -15,15 +15,11 @@ fn repository_folder_is_the_builtin_set() {
     for n in TEMPLATE_NAMES {
         assert_eq!(disk.source(n), builtin.source(n), "{n}");
     }
-    // The function list comes from planner_dsl's registry, every function of it.
-    let sys = builtin.plan_system().unwrap();
-    assert!(sys.contains(planner_dsl::function_list_for_prompt().trim_end()));
-    for f in planner_dsl::registry() {
-        assert!(
-            sys.contains(&format!("agent.{}", f.signature())),
-            "{}",
-            f.name
-        );
+    // The step functions come from planner_dsl's registry, every one of them.
+    let sys = builtin.v2_system(None).unwrap();
+    for name in planner_dsl::typed::STEP_FUNCTIONS {
+        let f = planner_dsl::lookup(name).unwrap();
+        assert!(sys.contains(&f.signature()), "{}", f.name);
     }
 }
 
@@ -31,77 +27,62 @@ fn repository_folder_is_the_builtin_set() {
 fn variant_overrides_only_its_files() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
-        dir.path().join("codegen.md.j2"),
-        "Only ever answer with a ```rhai block. {{ 'VARIANT' | lower }}\n",
+        dir.path().join("v2_reask.md.j2"),
+        "Mind: {% for f in findings %}{{ f | upper }}{% endfor %}\n",
     )
     .unwrap();
     let p = Prompts::load_variant(repo_prompts(), dir.path()).unwrap();
-    let sys = p.plan_system().unwrap();
-    assert!(
-        sys.contains("Only ever answer with a ```rhai block. variant"),
-        "{sys}"
-    );
-    assert!(sys.contains("agent.get_obj_attributes("), "functions kept");
+    let m = p.v2_reask(&["no table".into()]).unwrap();
+    assert_eq!(m.content, "Mind: NO TABLE");
     assert_eq!(
-        p.source("attributes.md.j2"),
-        Prompts::builtin().source("attributes.md.j2")
+        p.source("v2_system.md.j2"),
+        Prompts::builtin().source("v2_system.md.j2")
     );
     assert!(p
-        .origin("codegen.md.j2")
+        .origin("v2_reask.md.j2")
         .unwrap()
-        .ends_with("codegen.md.j2"));
-    assert!(p.origin("system.md.j2").unwrap().contains("system.md.j2"));
+        .ends_with("v2_reask.md.j2"));
+    assert!(p
+        .origin("v2_system.md.j2")
+        .unwrap()
+        .contains("v2_system.md.j2"));
 }
 
 #[test]
 fn shared_prefix_is_identical_across_instructions() {
     let p = Prompts::builtin();
-    let a = p
-        .plan_messages(
-            "go to the bed",
-            &[Tuple::new("bed", None, None)],
-            Some("objects: 1 bed (1 white)"),
-            None,
-        )
+    let scene = "objects: bed (1 white)";
+    let a = p.v2_system(Some(scene)).unwrap();
+    let b = p.v2_system(Some(scene)).unwrap();
+    assert_eq!(a, b);
+    // What varies is in the request only.
+    let r1 = p.v2_request("go to the bed", None, Some(scene)).unwrap();
+    let r2 = p
+        .v2_request("face north", Some("visited so far: bed 3"), Some(scene))
         .unwrap();
-    let b = p
-        .plan_messages(
-            "go to the tv",
-            &[Tuple::new("tv", None, None)],
-            Some("objects: 1 bed (1 white)"),
-            Some("\"x\" -> stopped at bed"),
-        )
-        .unwrap();
-    assert_eq!(a[0], b[0]);
+    assert!(r1.content.ends_with("> go to the bed"), "{}", r1.content);
     assert!(
-        a[1].content.ends_with("Objects: [(bed, None, None)]"),
+        r2.content
+            .contains("Earlier in this conversation: visited so far: bed 3"),
         "{}",
-        a[1].content
+        r2.content
     );
-    assert!(
-        b[1].content.contains("Earlier in this conversation: \"x\""),
-        "{}",
-        b[1].content
-    );
-    let e1 = p.extract_messages("go to the bed", None).unwrap();
-    let e2 = p.extract_messages("face north", None).unwrap();
-    assert_eq!(e1[0], e2[0]);
-    assert_eq!(e2[1].content, "I: face north");
+    assert!(!a.contains("go to the bed") && !a.contains("face north"));
 }
 
 #[test]
 fn broken_variants_fail_at_load_with_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("examples.md.j2"), "fine\n{% if %}\n").unwrap();
+    std::fs::write(dir.path().join("v2_system.md.j2"), "fine\n{% if %}\n").unwrap();
     let e = Prompts::load(dir.path()).unwrap_err();
     let PromptError::Template { origin, line, .. } = &e else {
         panic!("{e}")
     };
-    assert!(origin.ends_with("examples.md.j2"), "{e}");
+    assert!(origin.ends_with("v2_system.md.j2"), "{e}");
     assert_eq!(*line, Some(2), "{e}");
 
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("codgen.md.j2"), "typo\n").unwrap();
+    std::fs::write(dir.path().join("v2_sytem.md.j2"), "typo\n").unwrap();
     assert!(matches!(
         Prompts::load(dir.path()),
         Err(PromptError::UnknownFile { .. })
@@ -109,9 +90,9 @@ fn broken_variants_fail_at_load_with_file_and_line() {
 
     // A variable that does not exist is an error when rendered, not silent emptiness.
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("plan_request.md.j2"), "{{ instrction }}\n").unwrap();
+    std::fs::write(dir.path().join("v2_request.md.j2"), "{{ instrction }}\n").unwrap();
     let p = Prompts::load(dir.path()).unwrap();
-    assert!(p.plan_messages("x", &[], None, None).is_err());
+    assert!(p.v2_request("x", None, None).is_err());
 
     assert!(matches!(
         Prompts::load("/nonexistent/prompts"),

@@ -12,7 +12,7 @@ use std::sync::{Arc, Mutex};
 
 use agent::v2::answer::parse_answer;
 use agent::v2::grammar::Vocabulary;
-use agent::{plan_instruction, Outcome, Pipeline, PlanContext, PlanSource, Prompts};
+use agent::{plan_instruction, Outcome, PlanContext, PlanSource, Prompts};
 use llm::{
     Completion, CompletionRequest, FinishReason, LlamaCppBackend, LlamaCppConfig, LlmBackend,
     LlmError, Role,
@@ -29,9 +29,7 @@ fn flat_a() -> Arc<IvlMap> {
 }
 
 fn v2<'a>(map: &'a IvlMap, robot: &'a SimRobot) -> PlanContext<'a> {
-    let mut c = PlanContext::new(map).with_robot(robot);
-    c.options.pipeline = Pipeline::V2;
-    c
+    PlanContext::new(map).with_robot(robot)
 }
 
 /// Answers from a fixed list, in order, and keeps every request.
@@ -213,7 +211,6 @@ fn no_rule_changes_a_typed_answer() {
         assert_eq!(p.script, a.plan.to_rhai(), "{instruction}");
         assert_eq!(TypedPlan::parse(&p.script).unwrap(), a.plan);
         assert_eq!(p.tuples, a.tuples, "{instruction}");
-        assert!(p.fixes.is_empty());
         assert_eq!(p.source, PlanSource::Llm { repairs: 0 });
     }
 }
@@ -258,6 +255,8 @@ fn smollm2_answers_follow_the_grammar_built_from_the_map() {
     let vocab = Vocabulary::for_map(&map);
     let mut ctx = v2(&map, &robot);
     ctx.options.plan_max_tokens = 160;
+    // The three most similar worked examples only: a short prompt for the small model.
+    ctx.options.examples = Some(3);
     for instruction in [
         "go to the second black chair and then face the tv",
         "could you swing by the fridge and come back here",
@@ -306,8 +305,8 @@ fn with_all_examples_everything_before_the_request_is_the_same_for_every_map() {
         (&office, "go to a chair please"),
     ] {
         let robot = SimRobot::new(map.clone());
-        let mut ctx = v2(map, &robot);
-        ctx.options.all_examples = true;
+        let ctx = v2(map, &robot);
+        assert_eq!(ctx.options.examples, None, "every example is the default");
         let out = plan_instruction(&backend, &prompts, instruction, &ctx).unwrap();
         assert!(matches!(out, Outcome::Plan(_)), "{out:?}");
     }

@@ -223,56 +223,22 @@ pub(crate) struct ModelArgs {
     /// llama: no prompt cache on disk (every run evaluates its prompts from scratch).
     #[arg(long)]
     pub(crate) no_prompt_cache: bool,
-    /// Grammar-constrained decoding (llama; openai only with --send-grammar): `tuples`
-    /// holds step 1 to the tuple notation, `script` holds step 2 to calls of the function
-    /// library.
-    #[arg(long, value_enum, default_value_t = Grammar::Tuples)]
-    pub(crate) grammar: Grammar,
-    /// openai: send the --grammar grammars to the server as GBNF in the request's
+    /// Decode without the answer's grammar (llama; openai only with --send-grammar):
+    /// measures the model alone.
+    #[arg(long)]
+    pub(crate) no_grammar: bool,
+    /// openai: send the answer's grammar to the server as GBNF in the request's
     /// `grammar` field (llama-server takes it; most other servers do not).
     #[arg(long)]
     pub(crate) send_grammar: bool,
-    /// Use step 1's tuples as the model wrote them: no re-ask on missed words and no
-    /// reconciliation with the instruction's words (measures the model alone).
-    #[arg(long)]
-    pub(crate) raw_tuples: bool,
-    /// Language layer: v1 (two steps, word tables, repairs) or v2 (one constrained
-    /// call per instruction, typed checks, one re-ask, then a question).
-    #[arg(long, value_enum, default_value_t = PipelineArg::V1)]
-    pub(crate) pipeline: PipelineArg,
-    /// v2: worked examples shown per instruction (the most similar to it).
-    #[arg(long, default_value_t = 3)]
-    pub(crate) examples: usize,
-    /// v2: every worked example in the static, cached prefix (no retrieval; the map's
-    /// summary moves into the request).
-    #[arg(long)]
-    pub(crate) all_examples: bool,
-    /// v2, llama: hold the answer with llama.cpp's GBNF sampler instead of llguidance
+    /// Show the K worked examples most similar to each instruction (ranked by MiniLM)
+    /// instead of all of them in the cached prefix.
+    #[arg(long, value_name = "K")]
+    pub(crate) examples: Option<usize>,
+    /// llama: hold the answer with llama.cpp's GBNF sampler instead of llguidance
     /// (slower; for comparison).
     #[arg(long)]
     pub(crate) gbnf: bool,
-}
-
-/// `--pipeline`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum PipelineArg {
-    /// Two steps with word tables and repairs.
-    V1,
-    /// One constrained call per instruction.
-    V2,
-}
-
-/// Which steps decode under a GBNF grammar.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum Grammar {
-    /// Neither.
-    None,
-    /// Step 1 (tuples).
-    Tuples,
-    /// Step 2 (scripts).
-    Script,
-    /// Both.
-    Both,
 }
 
 impl ModelArgs {
@@ -297,18 +263,9 @@ impl ModelArgs {
 
     pub(crate) fn plan_options(&self) -> PlanOptions {
         PlanOptions {
-            tuple_grammar: matches!(self.grammar, Grammar::Tuples | Grammar::Both),
-            script_grammar: matches!(self.grammar, Grammar::Script | Grammar::Both),
-            tuple_check: !self.raw_tuples,
-            reconcile: !self.raw_tuples,
-            pipeline: match self.pipeline {
-                PipelineArg::V1 => agent::Pipeline::V1,
-                PipelineArg::V2 => agent::Pipeline::V2,
-            },
             examples: self.examples,
-            all_examples: self.all_examples,
             llguidance: !self.gbnf,
-            answer_grammar: !matches!(self.grammar, Grammar::None),
+            answer_grammar: !self.no_grammar,
             ..PlanOptions::default()
         }
     }

@@ -3,7 +3,7 @@
 use std::sync::Arc;
 
 use agent::v2::examples::{EmbedFailure, Embedder};
-use agent::{Pipeline, PlanOptions, Prompts};
+use agent::{PlanOptions, Prompts};
 use map_build::embed::TextEncoder;
 
 struct MiniLm(TextEncoder);
@@ -24,11 +24,12 @@ impl Embedder for MiniLm {
     }
 }
 
-/// `prompts` with its worked examples ranked by MiniLM when the v2 pipeline plans; when
+/// `prompts` with its worked examples ranked by MiniLM when some are picked per
+/// instruction (`--examples K`; by default all are shown and none is ranked); when
 /// the encoder cannot be loaded (no `scripts/setup.sh` yet) a warning says so and the
 /// examples are ranked by words.
 pub(crate) fn with_retrieval(prompts: Prompts, options: &PlanOptions) -> Prompts {
-    if options.pipeline != Pipeline::V2 {
+    if options.examples.is_none() {
         return prompts;
     }
     match TextEncoder::minilm(None) {

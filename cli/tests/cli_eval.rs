@@ -223,7 +223,7 @@ fn extraction_suite_recorded_then_replayed_from_a_cassette() {
 }
 
 #[test]
-fn send_grammar_passes_the_tuple_grammar_to_an_openai_server() {
+fn send_grammar_passes_the_objects_grammar_to_an_openai_server() {
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
@@ -279,8 +279,8 @@ fn send_grammar_passes_the_tuple_grammar_to_an_openai_server() {
                 .collect::<Vec<_>>(),
         );
     }
-    // Without the flag no request carries a grammar; with it step 1's does (the tuple
-    // grammar of --grammar tuples, the default), as GBNF text.
+    // Without the flag no request carries a grammar; with it the objects line's does, as
+    // GBNF text.
     assert!(grammars[0].iter().all(Option::is_none), "{:?}", grammars[0]);
     let g = grammars[1][0]
         .as_ref()

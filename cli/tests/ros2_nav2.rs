@@ -1,10 +1,10 @@
 //! `ivlmap run`, `chat` and `serve` with `--robot nav2` against the real ROS 2 stack: an
 //! rclpy node (Kilted wheels, Fast DDS; `scripts/ros2-venv.sh`) hosting
 //! `navigate_to_pose` with Nav2's own action type and publishing /tf, inside `unshare -n`
-//! with a random ROS_DOMAIN_ID. Chat and serve answer from a cassette recorded from
-//! SmolLM2 (`cassettes/smollm2_sofa_kitchen.jsonl`: `ivlmap chat` and `ivlmap serve`
-//! with `--backend llama --record`, instructions "go to the red sofa" and "go to the
-//! kitchen").
+//! with a random ROS_DOMAIN_ID. Chat and serve answer from a cassette recorded from the
+//! default model (`cassettes/sofa_kitchen.jsonl`, Qwen2.5-Coder-1.5B: `ivlmap chat
+//! --record` on "go to the red sofa", ":preview go to the kitchen", "go to the kitchen",
+//! then a new chat on "go to the kitchen"; SmolLM2 answers these with a bathtub).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 #[path = "../../robot_ros2/tests/common/netns.rs"]
@@ -121,7 +121,7 @@ fn start_node(v: &Path, repo: &Path) -> Child {
 
 fn cassette() -> String {
     ivlmap_tests::repo()
-        .join("cli/tests/cassettes/smollm2_sofa_kitchen.jsonl")
+        .join("cli/tests/cassettes/sofa_kitchen.jsonl")
         .display()
         .to_string()
 }

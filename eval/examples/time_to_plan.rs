@@ -20,7 +20,7 @@
 //!
 //! Output: one JSON line per plan on stdout, then a Markdown table of p50/p95 per kind
 //! and cache mode, with mean prompt tokens, cached prompt tokens, LLM calls and how many
-//! plans came from the template (no step-2 call).
+//! plans needed the re-ask.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -67,7 +67,7 @@ struct Side {
     prompt_tokens: u64,
     cached_tokens: u64,
     llm_calls: u64,
-    template: u64,
+    reasked: u64,
     plans: u64,
 }
 
@@ -82,7 +82,7 @@ impl Side {
             self.prompt_tokens as f64 / n,
             self.cached_tokens as f64 / n,
             self.llm_calls as f64 / n,
-            self.template,
+            self.reasked,
             self.plans,
         )
     }
@@ -99,30 +99,30 @@ fn plan_once(
     let t0 = Instant::now();
     let out = plan_instruction(backend, prompts, instruction, &ctx);
     let ms = t0.elapsed().as_secs_f64() * 1000.0;
-    let (kind, timing, template) = match &out {
+    let (kind, timing, reasked) = match &out {
         Ok(Outcome::Plan(p)) => (
             "plan",
             Some(p.timing),
-            matches!(p.source, PlanSource::Template),
+            matches!(p.source, PlanSource::Llm { repairs } if repairs > 0),
         ),
         Ok(Outcome::Question(_)) => ("question", None, false),
         Ok(Outcome::Refusal(_)) => ("refusal", None, false),
         Err(_) => ("error", None, false),
     };
-    let v = json!({"instruction": instruction, "ms": ms, "outcome": kind, "template": template,
+    let v = json!({"instruction": instruction, "ms": ms, "outcome": kind, "reasked": reasked,
         "llm_calls": timing.map(|t| t.llm_calls), "prompt_tokens": timing.map(|t| t.prompt_tokens),
         "cached_prompt_tokens": timing.map(|t| t.cached_prompt_tokens)});
-    Ok((ms, v, timing, template))
+    Ok((ms, v, timing, reasked))
 }
 
-fn record(side: &mut Side, ms: f64, timing: Option<agent::Timing>, template: bool) {
+fn record(side: &mut Side, ms: f64, timing: Option<agent::Timing>, reasked: bool) {
     side.ms.push(ms.round() as u64);
     if let Some(t) = timing {
         side.plans += 1;
         side.prompt_tokens += t.prompt_tokens;
         side.cached_tokens += t.cached_prompt_tokens;
         side.llm_calls += u64::from(t.llm_calls);
-        side.template += u64::from(template);
+        side.reasked += u64::from(reasked);
     }
 }
 
@@ -224,7 +224,7 @@ fn main() -> Result<(), BoxError> {
                     continue;
                 }
                 let b = if use_cache { &cached } else { &uncached };
-                let (ms, mut v, timing, template) =
+                let (ms, mut v, timing, reasked) =
                     plan_once(b, &prompts, instruction, &t.map, &robot)?;
                 v["kind"] = json!(kind);
                 v["prefix_cache"] = json!(use_cache);
@@ -233,7 +233,7 @@ fn main() -> Result<(), BoxError> {
                     if use_cache { &mut on } else { &mut off },
                     ms,
                     timing,
-                    template,
+                    reasked,
                 );
                 eprintln!(
                     "{kind} #{n} cache={use_cache}: {:.2} s  {instruction}",
@@ -248,7 +248,7 @@ fn main() -> Result<(), BoxError> {
         "\nmodel {}, {threads} threads\n",
         model.file_name().unwrap_or_default().to_string_lossy()
     );
-    println!("| instructions | n | p50 s | p95 s | prompt tok | cached tok | LLM calls | template plans |");
+    println!("| instructions | n | p50 s | p95 s | prompt tok | cached tok | LLM calls | re-asked plans |");
     println!("|---|---|---|---|---|---|---|---|");
     for r in rows {
         println!("{r}");

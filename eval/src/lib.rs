@@ -2,7 +2,7 @@
 //! variant, scored per formats.md, with the VLMaps baseline for the paper's comparison.
 //!
 //! - [`suite::load_extract_suite`] / [`suite::load_nav_suite`]: read suites; errors name file, line, field.
-//! - [`run_extract`]: step 1 on each case, compared with `expected` ([`agent::tuples::same_tuples`]).
+//! - [`run_extract`]: the objects line of each case ([`agent::extract_tuples`]), compared with `expected` ([`agent::tuples::same_tuples`]).
 //! - [`chat::run_chat`]: chat suites, turn by turn in one session; turn accuracy and
 //!   dialogue success.
 //! - [`run_nav`]: each task planned by a [`Method`] and executed on a simulated robot from
@@ -23,7 +23,7 @@ use std::time::Instant;
 use map_core::{IvlMap, Robot, SimRobot, Trajectory};
 use planner_dsl::{Limits, Plan};
 
-use agent::pipeline::extract_tuples_with;
+use agent::extract_tuples;
 use agent::tuples::same_tuples;
 use agent::{plan_instruction, Outcome, PlanContext, PlanOptions, Prompts, Tuple};
 use llm::LlmBackend;
@@ -59,7 +59,7 @@ impl Method {
     }
 }
 
-/// Step 1 on every case; `on_case` sees each result as it is made (for progress).
+/// The objects line of every case; `on_case` sees each result as it is made (for progress).
 pub fn run_extract(
     cases: &[ExtractCase],
     backend: &dyn LlmBackend,
@@ -71,7 +71,7 @@ pub fn run_extract(
         .iter()
         .map(|c| {
             let t0 = Instant::now();
-            let r = extract_tuples_with(backend, prompts, &c.instruction, None, options);
+            let r = extract_tuples(backend, prompts, &c.instruction, options);
             let latency_ms = ms(t0);
             let res = match r {
                 Ok((got, _)) => CaseResult {
@@ -133,7 +133,7 @@ fn plan_task(
                     plan: Err(need()),
                 };
             };
-            match extract_tuples_with(b, prompts, &task.instruction, None, options) {
+            match extract_tuples(b, prompts, &task.instruction, options) {
                 Ok((tuples, _)) => Planned {
                     plan: Plan::compile(&vlmap_script(&tuples)).map_err(|e| e.to_string()),
                     tuples: Some(tuples),

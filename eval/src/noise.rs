@@ -30,8 +30,8 @@ use serde::Serialize;
 use super::baseline::vlmap_script;
 use super::score::{nav_scores, reached};
 use super::suite::NavTask;
-use agent::checks::{library_calls, Arg};
 use agent::Tuple;
+use planner_dsl::typed::TypedPlan;
 
 /// The noise kinds a rate may apply to (`--kinds`).
 pub const NOISE_KINDS: [&str; 5] = ["label_flip", "fragment", "merge", "drop", "colour_shift"];
@@ -118,21 +118,24 @@ pub struct NoiseStudy {
     pub effects: Vec<NoiseEffects>,
 }
 
-/// The VLMaps tuples of a reference plan: each `get_obj_attributes` name and each
-/// `move_to_object` string (a region or bare category), in source order; ordinals,
-/// colours and orders are dropped.
+/// The VLMaps tuples of a reference plan: each selection's category and each bare
+/// name (a region or category) a step goes to, in source order; ordinals, colours and
+/// orders are dropped.
 ///
 /// # Errors
-/// The parse error (with its position) when the plan is not valid Rhai.
+/// The parse error (with its position) when the plan is not a straight-line plan.
 pub fn reference_tuples(src: &str) -> Result<Vec<Tuple>, String> {
-    Ok(library_calls(src)?
-        .into_iter()
-        .filter(|c| c.function == "get_obj_attributes" || c.function == "move_to_object")
-        .filter_map(|c| match c.args.first() {
-            Some(Arg::Str(name)) => Some(Tuple::new(name, None, None)),
-            _ => None,
-        })
-        .collect())
+    let plan = TypedPlan::parse(src).map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    for step in &plan.steps {
+        for t in step.targets() {
+            out.push(Tuple::new(&t.name, None, None));
+        }
+        for n in step.names() {
+            out.push(Tuple::new(n, None, None));
+        }
+    }
+    Ok(out)
 }
 
 /// The two plans of a task: ivlmap (reference) and vlmap (nearest of each category).

@@ -144,7 +144,7 @@
     try {
       const info = await api("GET", "/api/info");
       $("scene").textContent = "map: " + info.scene;
-      $("backend").textContent = `${info.backend} · ${info.model || "?"} · ${info.pipeline}`;
+      $("backend").textContent = `${info.backend} · ${info.model || "?"} · examples: ${info.examples}`;
     } catch (e) { note("cannot reach the server: " + e.message, true); return; }
     S.map = await api("GET", "/api/map");
     fit();

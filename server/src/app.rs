@@ -25,7 +25,7 @@ pub struct Service {
     pub backend: Arc<dyn LlmBackend>,
     /// The prompts.
     pub prompts: Prompts,
-    /// Language-layer knobs (pipeline, grammars, ...).
+    /// Language-layer knobs (worked examples, grammar, re-ask, ...).
     pub options: PlanOptions,
     /// Limits every script runs under.
     pub limits: Limits,
@@ -40,7 +40,7 @@ impl std::fmt::Debug for Service {
             .field("map", &self.map.name)
             .field("backend", &self.backend.name())
             .field("model", &self.backend.model())
-            .field("pipeline", &self.options.pipeline)
+            .field("examples", &self.options.examples)
             .field("robot", &self.robot.as_ref().map(|r| r.kind().to_string()))
             .finish_non_exhaustive()
     }

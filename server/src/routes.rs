@@ -167,7 +167,8 @@ async fn info(State(st): St) -> Json<Value> {
         "scene": svc.map.name,
         "backend": svc.backend.name(),
         "model": svc.backend.model(),
-        "pipeline": svc.options.pipeline,
+        // Worked examples per request: "all" (in the cached prefix) or the K most similar.
+        "examples": svc.options.examples.map_or_else(|| "all".to_string(), |k| k.to_string()),
         "prompts": svc.prompts.label(),
         "queue": st.queue.stats(),
         "sessions": st.sessions.len(),

@@ -163,6 +163,24 @@ fn check_tuples(
                 .any(|o| matches!(o, planner_dsl::typed::Object::Instance(_)))
     });
     let used = plan_labels(map, plan, pose);
+    // An empty objects line for a plan that picks what the person named.
+    if tuples.is_empty() {
+        let named: Vec<String> = said_names(map, &words(instruction))
+            .into_iter()
+            .filter(|(_, label)| used.contains(label))
+            .map(|(said, _)| said)
+            .collect();
+        if !named.is_empty() {
+            out.push(Finding::new(
+                FindingKind::Parts,
+                format!(
+                    "the objects line is empty, but the person named {}: list each object they named",
+                    named.join(", ")
+                ),
+                format!("is it the {} you mean?", named.join(" and the ")),
+            ));
+        }
+    }
     let said = words(instruction).join(" ");
     let said_words = format!(" {said} ");
     for t in tuples {
@@ -216,16 +234,7 @@ fn check_tuples(
                 continue;
             }
         }
-        let reached = map
-            .instances
-            .iter()
-            .any(|i| visited.contains(&i.id) && i.label == label);
-        let referred = by_reference
-            && refs
-                .iter()
-                .filter_map(|id| map.instance_by_id(*id))
-                .any(|i| i.label == label);
-        if !used.contains(&label) && !reached && !referred {
+        if !accounted_for(map, &label, &used, visited, by_reference.then_some(refs)) {
             out.push(Finding::new(
                 FindingKind::Parts,
                 format!(
@@ -237,6 +246,22 @@ fn check_tuples(
         }
     }
     out
+}
+
+/// Whether the plan accounts for `label`: it names it (`used`), its dry run reached one
+/// (`visited`), or, where the plan can reach earlier stops (`refs`: the conversation's
+/// instances, when the plan moves by id or position), the conversation visited one.
+fn accounted_for(
+    map: &IvlMap,
+    label: &str,
+    used: &[String],
+    visited: &[u32],
+    refs: Option<&[u32]>,
+) -> bool {
+    let is = |id: &u32| map.instance_by_id(*id).is_some_and(|i| i.label == label);
+    used.iter().any(|u| u == label)
+        || visited.iter().any(is)
+        || refs.is_some_and(|r| r.iter().any(is))
 }
 
 /// The map object a colour word at `i` is said of: the name right after it, past other
@@ -471,6 +496,123 @@ fn check_words(
     out
 }
 
+/// The names the map holds that the person said, in order, once each: a label or a
+/// region, one or two words ("coffee table", "living room"), or the plural of its last
+/// word ("the two tables"). A two-word name takes its words: "coffee table" is not also
+/// a "table". Synonyms ("couch") are not read here, so they are never judged.
+fn said_names(map: &IvlMap, w: &[String]) -> Vec<(String, String)> {
+    let names: Vec<(String, Vec<String>)> = names_on_map(map)
+        .into_iter()
+        .map(|n| {
+            let ws = words(&n);
+            (n, ws)
+        })
+        .filter(|(_, ws)| !ws.is_empty())
+        .collect();
+    let matches = |at: usize, ws: &[String]| {
+        let n = ws.len();
+        at + n <= w.len()
+            && w[at..at + n - 1] == ws[..n - 1]
+            && (w[at + n - 1] == ws[n - 1]
+                || w[at + n - 1] == map_core::matcher::plural(&ws[n - 1]))
+    };
+    let mut out: Vec<(String, String)> = Vec::new();
+    let mut i = 0;
+    while i < w.len() {
+        let best = names
+            .iter()
+            .filter(|(_, ws)| matches(i, ws))
+            .max_by_key(|(_, ws)| ws.len());
+        match best {
+            Some((name, ws)) => {
+                if !out.iter().any(|(_, l)| l == name) {
+                    out.push((w[i..i + ws.len()].join(" "), name.clone()));
+                }
+                i += ws.len();
+            }
+            None => i += 1,
+        }
+    }
+    out
+}
+
+/// Every name the person said that the plan leaves out: no target, bare name, region or
+/// referred instance of it, and the dry run stops at none ("go to the red sofa" answered
+/// with a bathtub).
+fn check_names(
+    map: &IvlMap,
+    instruction: &str,
+    plan: &TypedPlan,
+    pose: Pose,
+    visited: &[u32],
+    refs: &[u32],
+) -> Vec<Finding> {
+    let used = plan_labels(map, plan, pose);
+    let by_position = plan.steps.iter().any(|s| matches!(s, Step::MoveTo(_)));
+    let w = words(instruction);
+    let mut out = Vec::new();
+    for (said, label) in said_names(map, &w) {
+        // "go back to the sofa you visited" may be a move to where the robot stopped.
+        if !accounted_for(map, &label, &used, visited, by_position.then_some(refs)) {
+            out.push(Finding::new(
+                FindingKind::Word,
+                format!("the person said \"{said}\", but the plan neither goes to nor uses a {label}: pick it with get_obj(\"{label}\", ...) where the person wants it"),
+                format!("what should I do with the {said}?"),
+            ));
+        }
+    }
+    out
+}
+
+/// Colours in the plan that the person never said: a target's `colour` or `not_colour`
+/// that no word of the instruction names ("go to the fridge" answered with
+/// `get_obj("fridge", #{not_colour: "white"})`). A made-up colour picks another instance
+/// or none, so it is re-asked, never dropped here. `known` holds the colours the
+/// conversation told the model ("the other one" after the red sofa is not red).
+pub(crate) fn check_unsaid_colours(
+    instruction: &str,
+    known: &[String],
+    plan: &TypedPlan,
+) -> Vec<Finding> {
+    let said: Vec<String> = words(instruction)
+        .iter()
+        .chain(known)
+        .filter_map(|w| normalise_colour(w))
+        .map(|c| canonical(&c))
+        .collect();
+    // A typed colour ("blak") says the colour it is one or two edits from.
+    let close = |c: &str| {
+        let limit = if c.chars().count() <= 5 { 1 } else { 2 };
+        said.iter()
+            .any(|w| w == c || strsim::damerau_levenshtein(w, c) <= limit)
+    };
+    let is_said = |c: &str| close(&canonical(c)) || words(c).iter().any(|w| close(&canonical(w)));
+    let mut out: Vec<Finding> = Vec::new();
+    for t in targets(plan) {
+        for (field, c) in [("colour", &t.colour), ("not_colour", &t.not_colour)] {
+            let Some(c) = c.as_deref() else { continue };
+            if is_said(c) {
+                continue;
+            }
+            let f = Finding::new(
+                FindingKind::Word,
+                format!(
+                    "the plan picks a {} with {field} \"{c}\", but the person did not say \"{c}\": give a colour only where the person's words do",
+                    t.name
+                ),
+                match field {
+                    "colour" => format!("do you mean a {c} {}?", t.name),
+                    _ => format!("do you mean a {} that is not {c}?", t.name),
+                },
+            );
+            if !out.contains(&f) {
+                out.push(f);
+            }
+        }
+    }
+    out
+}
+
 /// Everything found in `plan` and `tuples` for `instruction` on `map`. `visited` holds
 /// the instances the plan's dry run stopped at (empty without a dry run): a colour is
 /// accounted for when a target says it or when the plan reaches an instance of it ("the
@@ -487,7 +629,14 @@ pub fn check_answer(
     refs: &[u32],
 ) -> Vec<Finding> {
     let mut out = check_tuples(map, instruction, tuples, plan, pose, visited, refs);
+    out.extend(check_names(map, instruction, plan, pose, visited, refs));
     out.extend(check_words(map, instruction, plan, pose, visited));
+    let known: Vec<String> = refs
+        .iter()
+        .filter_map(|id| map.instance_by_id(*id))
+        .filter_map(|i| i.colour.clone())
+        .collect();
+    out.extend(check_unsaid_colours(instruction, &known, plan));
     // A plan with no step that moves or turns does nothing the person asked for.
     if !plan
         .steps
@@ -544,6 +693,128 @@ mod tests {
             "objects: [(chair, 2, black), (sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, colour: \"black\"}));\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));",
         );
         assert!(f.is_empty(), "{f:?}");
+    }
+
+    #[test]
+    fn a_colour_the_person_did_not_say_is_found() {
+        // SmolLM2's answer to "go to the fridge" in the browser test.
+        let f = findings(
+            "go to the fridge",
+            "objects: [(fridge, None, None)]\nplan:\nmove_to_object(get_obj(\"fridge\", #{not_colour: \"white\"}));",
+        );
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert_eq!(f[0].kind, FindingKind::Word);
+        assert!(f[0].to_model.contains("not_colour \"white\""), "{f:?}");
+        assert_eq!(f[0].to_user, "do you mean a fridge that is not white?");
+        let f = findings(
+            "go to the fridge",
+            "objects: []\nplan:\nmove_to_object(get_obj(\"fridge\"));",
+        );
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert_eq!(f[0].kind, FindingKind::Parts);
+        assert!(f[0].to_model.contains("objects line is empty"), "{f:?}");
+        let f = findings(
+            "go to the sofa",
+            "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));",
+        );
+        assert!(
+            f.iter().any(|x| x.to_user == "do you mean a red sofa?"),
+            "{f:?}"
+        );
+        // In a conversation, the colours of what was visited are known: "the other one"
+        // after the red sofa is the sofa that is not red.
+        let m = map();
+        let red = m
+            .instances
+            .iter()
+            .find(|i| i.label == "sofa" && i.colour.as_deref() == Some("red"))
+            .expect("flat-a has a red sofa");
+        let a = parse_answer(
+            "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{not_colour: \"red\"}));",
+        )
+        .unwrap();
+        let f = check_answer(
+            &m,
+            "now the other one",
+            &a.tuples,
+            &a.plan,
+            m.start_pose,
+            &[],
+            &[red.id],
+        );
+        assert!(
+            f.iter().all(|x| !x.to_model.contains("did not say")),
+            "{f:?}"
+        );
+        // Said colours, in any spelling or position, are not findings.
+        for (instruction, answer) in [
+            (
+                "go to the sofa, the red one",
+                "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));",
+            ),
+            (
+                "go to the sofa that isn't black",
+                "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{not_colour: \"black\"}));",
+            ),
+            (
+                "pls go too the secnd blak chiar",
+                "objects: [(chair, 2, black)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, colour: \"black\"}));",
+            ),
+            (
+                "go to the gray chair",
+                "objects: [(chair, None, grey)]\nplan:\nmove_to_object(get_obj(\"chair\", #{colour: \"grey\"}));",
+            ),
+        ] {
+            let f = findings(instruction, answer);
+            assert!(
+                f.iter().all(|x| !x.to_model.contains("did not say")),
+                "{instruction}: {f:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_name_the_plan_leaves_out_is_found() {
+        // SmolLM2's answer to "go to the red sofa": an empty objects line and a bathtub.
+        let f = findings(
+            "go to the red sofa",
+            "objects: []\nplan:\nmove_to_object(get_obj(\"bathtub\", #{not_colour: \"red\"}));",
+        );
+        assert!(
+            f.iter()
+                .any(|x| x.kind == FindingKind::Word && x.to_model.contains("\"sofa\"")),
+            "{f:?}"
+        );
+        // A name said as an anchor, a room or in the plural is used when the plan picks
+        // it there; a two-word name is one name.
+        for (instruction, answer) in [
+            (
+                "go to the chair next to the black table",
+                "objects: [(chair, None, None), (table, None, black)]\nplan:\nmove_to_object(get_obj(\"chair\", #{near: get_obj(\"table\", #{colour: \"black\"})}));",
+            ),
+            (
+                "stop between the two sofas",
+                "objects: [(sofa, None, None)]\nplan:\nmove_between_the_two(\"sofa\");",
+            ),
+            (
+                "go to the chair in the kitchen",
+                "objects: [(chair, None, None), (kitchen, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{region: \"kitchen\"}));",
+            ),
+            (
+                "go to the living room",
+                "objects: [(living room, None, None)]\nplan:\nmove_to_object(\"living room\");",
+            ),
+        ] {
+            let f = findings(instruction, answer);
+            assert!(
+                f.iter().all(|x| !x.to_model.contains("neither goes to")),
+                "{instruction}: {f:?}"
+            );
+        }
+        let m = map();
+        let said = said_names(&m, &words("the living room, then the sofas and the tv"));
+        let labels: Vec<&str> = said.iter().map(|(_, l)| l.as_str()).collect();
+        assert_eq!(labels, ["living room", "sofa", "tv"]);
     }
 
     #[test]

@@ -33,7 +33,7 @@ use self::check::{check_answer, runtime_finding, Finding, FindingKind};
 use self::grammar::{answer_grammar, answer_lark, objects_grammar, objects_lark, Vocabulary};
 
 /// The messages of one request: system (+ scene), the nearest worked examples, the
-/// instruction. With `all` every worked example follows the system message instead and
+/// instruction. With `k` = `None` every worked example follows the system message instead and
 /// the scene opens the request: everything before the request is then the same for
 /// every map, and a prefix-caching backend evaluates it once.
 fn messages(
@@ -41,16 +41,18 @@ fn messages(
     instruction: &str,
     scene: Option<&str>,
     history: Option<&str>,
-    k: usize,
-    all: bool,
+    k: Option<usize>,
 ) -> Result<Vec<ChatMessage>, LanguageError> {
     let index = prompts.example_index()?;
-    let shown: Vec<&examples::WorkedExample> = if all {
-        index.examples().iter().collect()
-    } else {
-        index.nearest(instruction, k)
+    let shown: Vec<&examples::WorkedExample> = match k {
+        None => index.examples().iter().collect(),
+        Some(k) => index.nearest(instruction, k),
     };
-    let (system_scene, request_scene) = if all { (None, scene) } else { (scene, None) };
+    let (system_scene, request_scene) = if k.is_none() {
+        (None, scene)
+    } else {
+        (scene, None)
+    };
     let mut m = vec![ChatMessage::system(prompts.v2_system(system_scene)?)];
     for ex in shown {
         m.push(prompts.v2_request(&ex.instruction, ex.history.as_deref(), None)?);
@@ -73,18 +75,11 @@ pub fn extract(
 ) -> Result<(Vec<Tuple>, Timing), LanguageError> {
     let t0 = Instant::now();
     let mut req = CompletionRequest::new(
-        messages(
-            prompts,
-            instruction,
-            None,
-            None,
-            options.examples,
-            options.all_examples,
-        )?,
+        messages(prompts, instruction, None, None, options.examples)?,
         options.extract_max_tokens,
     );
     req.stop = vec!["\n".into()];
-    if options.tuple_grammar {
+    if options.answer_grammar {
         req.grammar = Some(objects_grammar());
         if options.llguidance {
             req.lark = Some(objects_lark());
@@ -207,7 +202,6 @@ pub fn plan_instruction(
         Some(&scene),
         ctx.history.as_deref(),
         ctx.options.examples,
-        ctx.options.all_examples,
     )?;
     let vocab = {
         let mut v = Vocabulary::for_map(ctx.map);
@@ -219,7 +213,7 @@ pub fn plan_instruction(
     let mut timing = Timing::default();
     let mut attempts = Vec::new();
     let mut findings = Vec::new();
-    let last_round = ctx.options.max_repairs.min(1);
+    let last_round = u32::from(ctx.options.reask);
     for round in 0..=last_round {
         let mut req = CompletionRequest::new(msgs.clone(), ctx.options.plan_max_tokens);
         req.grammar.clone_from(&grammar);
@@ -238,7 +232,6 @@ pub fn plan_instruction(
                     source: PlanSource::Llm { repairs: round },
                     timing,
                     attempts,
-                    fixes: Vec::new(),
                 })));
             }
             Err(f) if round == last_round => {

@@ -343,8 +343,23 @@ pub fn smol() -> Option<PathBuf> {
 }
 
 pub fn smol_backend(path: PathBuf) -> LlamaCppBackend {
+    // The default prompt holds every worked example (~3,500 tokens): 8192 leaves room
+    // for the request and the answer.
     let mut cfg = LlamaCppConfig::new(path);
-    cfg.n_ctx = 4096;
+    cfg.n_ctx = 8192;
+    LlamaCppBackend::new(cfg).unwrap()
+}
+
+/// The product's default model, if fetched.
+pub fn default_model() -> Option<PathBuf> {
+    ivlmap_tests::model(ivlmap_tests::DEFAULT_MODEL)
+}
+
+/// The default model as the binary runs it: 2 threads, its prompt prefix read back from
+/// the product's prompt cache on disk.
+pub fn default_backend(path: PathBuf) -> LlamaCppBackend {
+    let mut cfg = LlamaCppConfig::new(path);
+    cfg.prompt_cache_dir = Some(ivlmap_tests::prompt_cache_dir());
     LlamaCppBackend::new(cfg).unwrap()
 }
 

@@ -1,11 +1,8 @@
 //! End-to-end: an instruction in, a trajectory out, through the real parts.
 //!
-//! - [`language`]: the language pipeline with the real llama.cpp and SmolLM2, and the
+//! - [`language`]: the language layer with the real llama.cpp and SmolLM2, and the
 //!   same exchanges replayed from a cassette recorded from it.
-//! - [`pipeline_cache`]: the prefix cache across the pipeline's alternating prompts
-//!   (an ignored benchmark).
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // tests
 
 mod language;
-mod pipeline_cache;
