@@ -272,7 +272,9 @@ mod tests {
             assert!(!a.tuples.is_empty() || !picks, "line {}", e.line);
             // No example teaches a colour its instruction does not say.
             let known = crate::words::words(e.history.as_deref().unwrap_or_default());
-            let unsaid = super::super::check::check_unsaid_colours(&e.instruction, &known, &a.plan);
+            let unsaid = super::super::check::unsaid_colours(&e.instruction, &known, &a.plan);
+            assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
+            let unsaid = super::super::check::unsaid_directions(&e.instruction, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             planner_dsl::Plan::compile(&a.plan.to_rhai())
                 .unwrap_or_else(|err| panic!("example at line {}: {err}", e.line));
