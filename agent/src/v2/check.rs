@@ -249,7 +249,7 @@ fn check_tuples(
 }
 
 /// Whether the plan accounts for `label`: it names it (`used`), its dry run reached one
-/// (`visited`), or, where the plan can reach earlier stops (`refs`: the conversation's
+/// or, for a region, an object in it (`visited`), or, where the plan can reach earlier stops (`refs`: the conversation's
 /// instances, when the plan moves by id or position), the conversation visited one.
 fn accounted_for(
     map: &IvlMap,
@@ -259,8 +259,18 @@ fn accounted_for(
     refs: Option<&[u32]>,
 ) -> bool {
     let is = |id: &u32| map.instance_by_id(*id).is_some_and(|i| i.label == label);
+    // A region is accounted for when the plan stops at an object in it ("the yellow table
+    // in the kitchen" on a map whose one yellow table is there).
+    let inside = |id: &u32| {
+        map.regions.iter().any(|r| {
+            r.name == label
+                && map
+                    .instance_by_id(*id)
+                    .is_some_and(|i| r.polygon.contains(i.centroid))
+        })
+    };
     used.iter().any(|u| u == label)
-        || visited.iter().any(is)
+        || visited.iter().any(|id| is(id) || inside(id))
         || refs.is_some_and(|r| r.iter().any(is))
 }
 
@@ -900,6 +910,47 @@ mod tests {
                 "{instruction}: {f:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_region_the_plan_stops_in_is_accounted_for() {
+        // "the yellow table in the kitchen", answered without the region: the dry run
+        // stops at a yellow table in the kitchen, so the room is not asked about.
+        let m = map();
+        let kitchen = m.regions.iter().find(|r| r.name == "kitchen").unwrap();
+        let inside = m
+            .instances
+            .iter()
+            .find(|i| i.label != "wall" && kitchen.polygon.contains(i.centroid))
+            .expect("flat-a has an object in the kitchen");
+        let outside = m
+            .instances
+            .iter()
+            .find(|i| i.label == inside.label && !kitchen.polygon.contains(i.centroid));
+        let answer = format!(
+            "objects: [({0}, None, None), (kitchen, None, None)]\nplan:\nmove_to_object(get_obj(\"{0}\"));",
+            inside.label
+        );
+        let a = parse_answer(&answer).unwrap();
+        let instruction = format!("go to the {} in the kitchen", inside.label);
+        let asked = |visited: &[u32]| {
+            check_answer(
+                &m,
+                &instruction,
+                &a.tuples,
+                &a.plan,
+                m.start_pose,
+                visited,
+                &[],
+            )
+            .iter()
+            .any(|x| x.to_user.contains("kitchen"))
+        };
+        assert!(!asked(&[inside.id]));
+        if let Some(o) = outside {
+            assert!(asked(&[o.id]));
+        }
+        assert!(asked(&[]));
     }
 
     #[test]
