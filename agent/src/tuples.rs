@@ -469,6 +469,37 @@ pub fn parse_ordinal(raw: &str) -> Result<Option<i64>, String> {
     ))
 }
 
+/// The count a word of an instruction says, typos allowed: [`parse_ordinal`]'s numbers
+/// and words ("3", "3rd", "third", "three"), an ordinal or cardinal word of five letters
+/// or more one edit away ("thrid", "secnd"), and -2 for "penultimate". `None` for
+/// anything else, and for "last" and the superlatives (-1: they are not read as counts
+/// here).
+#[must_use]
+pub fn said_count(word: &str) -> Option<i64> {
+    let w = word.trim().to_lowercase();
+    if w.starts_with("penultim") {
+        return Some(-2);
+    }
+    if let Ok(Some(k)) = parse_ordinal(&w) {
+        return (k >= 1).then_some(k);
+    }
+    if w.chars().count() < 5 {
+        return None;
+    }
+    ORDINAL_WORDS
+        .iter()
+        .chain(CARDINAL_WORDS)
+        .position(|o| strsim::damerau_levenshtein(o, &w) <= 1)
+        .map(|i| {
+            let i = i as i64;
+            if i < ORDINAL_WORDS.len() as i64 {
+                i + 1
+            } else {
+                i - ORDINAL_WORDS.len() as i64 + 1
+            }
+        })
+}
+
 /// Superlatives that are the first in some order ("westernmost" = 1st from west to east).
 const SUPERLATIVES: &[(&str, &str)] = &[
     ("westernmost", "west_to_east"),

@@ -6,7 +6,7 @@
 //! cargo run --release -p eval --example time_to_plan -- \
 //!     --model ~/.cache/ivlmap/models/qwen2.5-coder-1.5b-instruct-q4_k_m.gguf \
 //!     [--threads 2] [--limit 24] [--uncached-limit 6] \
-//!     [--suite examples/suites/flat-a.nav.jsonl]...
+//!     [--suite examples/suites/flat-a.nav.jsonl]... [--fast-forward-side]
 //! ```
 //!
 //! Instructions: every clause of the navigation suites' tasks ("go to the second white
@@ -17,6 +17,10 @@
 //! request evaluates its whole prompt). The uncached side takes the first
 //! `--uncached-limit` instructions of each kind only (it costs the whole prompt each
 //! time); the two sides alternate which goes first.
+//!
+//! With `--fast-forward-side` the second backend keeps the prefix cache and fast-forwards
+//! the grammar's forced tokens instead (`LlamaCppConfig::fast_forward`), every instruction
+//! on both sides.
 //!
 //! Output: one JSON line per plan on stdout, then a Markdown table of p50/p95 per kind
 //! and cache mode, with mean prompt tokens, cached prompt tokens, LLM calls and how many
@@ -99,19 +103,22 @@ fn plan_once(
     let t0 = Instant::now();
     let out = plan_instruction(backend, prompts, instruction, &ctx);
     let ms = t0.elapsed().as_secs_f64() * 1000.0;
-    let (kind, timing, reasked) = match &out {
+    let (kind, timing, reasked, script) = match &out {
         Ok(Outcome::Plan(p)) => (
             "plan",
             Some(p.timing),
             matches!(p.source, PlanSource::Llm { repairs } if repairs > 0),
+            Some(p.script.clone()),
         ),
-        Ok(Outcome::Question(_)) => ("question", None, false),
-        Ok(Outcome::Refusal(_)) => ("refusal", None, false),
-        Err(_) => ("error", None, false),
+        Ok(Outcome::Question(_)) => ("question", None, false, None),
+        Ok(Outcome::Refusal(_)) => ("refusal", None, false, None),
+        Err(_) => ("error", None, false, None),
     };
-    let v = json!({"instruction": instruction, "ms": ms, "outcome": kind, "reasked": reasked,
+    let v = json!({"instruction": instruction, "ms": ms, "outcome": kind, "reasked": reasked, "script": script,
         "llm_calls": timing.map(|t| t.llm_calls), "prompt_tokens": timing.map(|t| t.prompt_tokens),
-        "cached_prompt_tokens": timing.map(|t| t.cached_prompt_tokens)});
+        "cached_prompt_tokens": timing.map(|t| t.cached_prompt_tokens),
+        "completion_tokens": timing.map(|t| t.completion_tokens),
+        "prompt_ms": timing.map(|t| t.prompt_ms), "generate_ms": timing.map(|t| t.generate_ms)});
     Ok((ms, v, timing, reasked))
 }
 
@@ -144,6 +151,10 @@ struct Args {
     /// Navigation suites (default: the three public ones).
     #[arg(long = "suite")]
     suites: Vec<PathBuf>,
+    /// Compare fast-forward instead of the prefix cache: the second side keeps the
+    /// prefix cache and decodes the grammar's forced tokens in one batch.
+    #[arg(long)]
+    fast_forward_side: bool,
 }
 
 fn main() -> Result<(), BoxError> {
@@ -153,6 +164,7 @@ fn main() -> Result<(), BoxError> {
         limit,
         uncached_limit,
         mut suites,
+        fast_forward_side,
     } = clap::Parser::parse();
     if suites.is_empty() {
         for s in ["flat-a", "office-b", "house-c"] {
@@ -185,9 +197,18 @@ fn main() -> Result<(), BoxError> {
     let mut cfg = LlamaCppConfig::new(&model);
     cfg.threads = threads;
     let cached = LlamaCppBackend::new(cfg.clone())?;
-    cfg.prefix_cache = false;
-    cfg.n_slots = 1;
+    if fast_forward_side {
+        cfg.fast_forward = true;
+    } else {
+        cfg.prefix_cache = false;
+        cfg.n_slots = 1;
+    }
     let uncached = LlamaCppBackend::new(cfg)?;
+    let other = if fast_forward_side {
+        "fast-forward"
+    } else {
+        "prefix cache off"
+    };
     let prompts = Prompts::builtin();
 
     // Warm-up: the first instruction of a chat session fills the cache with the shared
@@ -213,7 +234,7 @@ fn main() -> Result<(), BoxError> {
         for (n, (i, instruction)) in list.iter().enumerate() {
             let t = &tasks[*i];
             let robot = SimRobot::with_pose(t.map.clone(), t.start);
-            let with_off = n < uncached_limit;
+            let with_off = fast_forward_side || n < uncached_limit;
             let order: &[bool] = if n % 2 == 0 {
                 &[true, false]
             } else {
@@ -242,7 +263,7 @@ fn main() -> Result<(), BoxError> {
             }
         }
         rows.push(on.row(&format!("{kind}, prefix cache on")));
-        rows.push(off.row(&format!("{kind}, prefix cache off")));
+        rows.push(off.row(&format!("{kind}, {other}")));
     }
     println!(
         "\nmodel {}, {threads} threads\n",

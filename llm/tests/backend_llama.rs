@@ -275,8 +275,10 @@ fn a_lark_grammar_runs_under_llguidance_with_forced_tokens_fast_forwarded() {
         "{c:?}"
     );
     assert!(c.completion_tokens >= 10, "{c:?}");
-    // Only the digit is sampled (and the first token); the rest is forced.
-    assert!(c.forced_tokens + 3 >= c.completion_tokens, "{c:?}");
+    // Only the first token, the digit and the last token of each forced stretch (held
+    // back: the model may merge it with what follows) are sampled; the rest is forced.
+    assert!(c.forced_tokens + 6 >= c.completion_tokens, "{c:?}");
+    assert!(c.forced_tokens >= 10, "{c:?}");
     assert_eq!(c.finish_reason, FinishReason::Stop);
 
     // A malformed Lark grammar is a grammar error, and the backend keeps working.

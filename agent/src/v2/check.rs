@@ -17,7 +17,7 @@ use map_core::{IvlMap, ObjectOrder, Pose};
 use planner_dsl::typed::{Object, Step, Target, TypedPlan};
 
 use crate::pipeline::{colour_counts, colour_list, noun};
-use crate::tuples::{normalise_colour, parse_ordinal, parse_ordinal_with_order, Tuple};
+use crate::tuples::{normalise_colour, parse_ordinal, parse_ordinal_with_order, said_count, Tuple};
 use crate::words::words;
 
 /// What kind of disagreement a finding is.
@@ -720,6 +720,70 @@ pub(crate) fn unsaid_directions<'a>(instruction: &str, plan: &'a TypedPlan) -> V
         .collect()
 }
 
+/// Targets counted with an ordinal of 2 or more (either end: -2 is the second to last)
+/// when no word of the instruction says that count ("the small table next to the blue
+/// bed" answered with `#{ordinal: 2, near: ...}`, seen on people.nav; "the yellow table
+/// that's furthest from you" with `#{ordinal: 3, order: "far_to_near"}`). The first and
+/// the last (1, -1) are said in too many ways ("nearest", "furthest", "the last") to be
+/// judged here; [`check_words`] checks the superlatives. In a conversation (`in_chat`)
+/// counts are not judged: "the next one" may count on from what was visited. No worked
+/// example may have one.
+pub(crate) fn unsaid_ordinals<'a>(
+    instruction: &str,
+    in_chat: bool,
+    plan: &'a TypedPlan,
+) -> Vec<&'a Target> {
+    if in_chat {
+        return Vec::new();
+    }
+    let said: Vec<i64> = words(instruction)
+        .iter()
+        .filter_map(|w| said_count(w))
+        .collect();
+    targets(plan)
+        .into_iter()
+        .filter(|t| {
+            t.ordinal.abs() >= 2
+                && !said
+                    .iter()
+                    .any(|&k| k == t.ordinal.abs() || (k == -2 && t.ordinal == -2))
+        })
+        .collect()
+}
+
+/// [`unsaid_ordinals`] as findings: the re-ask asks to leave the count out.
+fn check_unsaid_ordinals(
+    map: &IvlMap,
+    instruction: &str,
+    in_chat: bool,
+    plan: &TypedPlan,
+    pose: Pose,
+) -> Vec<Finding> {
+    let mut out: Vec<Finding> = Vec::new();
+    for t in unsaid_ordinals(instruction, in_chat, plan) {
+        let to_user = match label_of(map, &t.name, pose) {
+            Some(l) => format!(
+                "which {} do you mean? there are {}",
+                t.name,
+                describe_label(map, &l)
+            ),
+            None => format!("which {} do you mean?", t.name),
+        };
+        let f = Finding::new(
+            FindingKind::Word,
+            format!(
+                "the plan picks the {} with ordinal {}, but the person said no such count: leave the ordinal out unless their words count (\"the third\", \"number 3\", \"second to last\")",
+                t.name, t.ordinal
+            ),
+            to_user,
+        );
+        if !out.contains(&f) {
+            out.push(f);
+        }
+    }
+    out
+}
+
 /// [`unsaid_directions`] as findings: the re-ask asks for the default order.
 fn check_unsaid_directions(instruction: &str, plan: &TypedPlan) -> Vec<Finding> {
     let mut out: Vec<Finding> = Vec::new();
@@ -765,6 +829,13 @@ pub fn check_answer(
         .collect();
     out.extend(check_unsaid_colours(map, instruction, &known, plan, pose));
     out.extend(check_unsaid_directions(instruction, plan));
+    out.extend(check_unsaid_ordinals(
+        map,
+        instruction,
+        !refs.is_empty(),
+        plan,
+        pose,
+    ));
     // A plan with no step that moves or turns does nothing the person asked for.
     if !plan
         .steps
@@ -884,6 +955,76 @@ mod tests {
                 "{instruction} {select}: {f:?}"
             );
         }
+    }
+
+    #[test]
+    fn an_ordinal_the_person_did_not_say_is_found() {
+        // Seen on people.nav: "the small table next to the blue bed" as the second table
+        // near the bed; "the yellow table that's furthest from you" as the third.
+        for (instruction, select) in [
+            (
+                "go to the small table next to the bed",
+                "#{ordinal: 2, near: get_obj(\"bed\")}",
+            ),
+            (
+                "go to the table that's furthest from you",
+                "#{ordinal: 3, order: \"far_to_near\"}",
+            ),
+            ("go to the third table", "#{ordinal: 2}"),
+            ("go to the last table", "#{ordinal: -2}"),
+        ] {
+            let f = findings(
+                instruction,
+                &format!("objects: [(table, None, None)]\nplan:\nmove_to_object(get_obj(\"table\", {select}));"),
+            );
+            assert!(
+                f.iter().any(|x| x.kind == FindingKind::Word
+                    && x.to_model.contains("said no such count")
+                    && x.to_user.starts_with("which table do you mean? there are")),
+                "{instruction}: {f:?}"
+            );
+        }
+        // Counts said as words, numbers, typos or "penultimate" pass, and so do the
+        // first and the last, however said.
+        for (instruction, select) in [
+            ("go to the second table", "#{ordinal: 2}"),
+            ("go to table number 3", "#{ordinal: 3}"),
+            ("go to table three", "#{ordinal: 3}"),
+            ("go to the 3rd table", "#{ordinal: 3}"),
+            ("go to the thrid table", "#{ordinal: 3}"),
+            ("go to the penultimate table", "#{ordinal: -2}"),
+            ("go to the second to last table", "#{ordinal: -2}"),
+            ("go to the table furthest away", "#{ordinal: -1}"),
+            ("go to the closest table", "#{ordinal: 1}"),
+        ] {
+            let f = findings(
+                instruction,
+                &format!("objects: [(table, None, None)]\nplan:\nmove_to_object(get_obj(\"table\", {select}));"),
+            );
+            assert!(
+                f.iter().all(|x| !x.to_model.contains("no such count")),
+                "{instruction} {select}: {f:?}"
+            );
+        }
+        // In a conversation a count may follow from what was visited ("the next one").
+        let m = map();
+        let a = parse_answer(
+            "objects: [(table, None, None)]\nplan:\nmove_to_object(get_obj(\"table\", #{ordinal: 2}));",
+        )
+        .unwrap();
+        let f = check_answer(
+            &m,
+            "now the next one",
+            &a.tuples,
+            &a.plan,
+            m.start_pose,
+            &[],
+            &[8],
+        );
+        assert!(
+            f.iter().all(|x| !x.to_model.contains("no such count")),
+            "{f:?}"
+        );
     }
 
     #[test]
