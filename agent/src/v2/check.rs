@@ -961,6 +961,18 @@ mod tests {
     fn an_ordinal_the_person_did_not_say_is_found() {
         // Seen on people.nav: "the small table next to the blue bed" as the second table
         // near the bed; "the yellow table that's furthest from you" as the third.
+        let counted = |instruction: &str, select: &str| {
+            let f = findings(
+                instruction,
+                &format!("objects: [(table, None, None)]\nplan:\nmove_to_object(get_obj(\"table\", {select}));"),
+            );
+            let found = f.iter().any(|x| {
+                x.kind == FindingKind::Word
+                    && x.to_model.contains("said no such count")
+                    && x.to_user.starts_with("which table do you mean? there are")
+            });
+            (found, f)
+        };
         for (instruction, select) in [
             (
                 "go to the small table next to the bed",
@@ -973,16 +985,8 @@ mod tests {
             ("go to the third table", "#{ordinal: 2}"),
             ("go to the last table", "#{ordinal: -2}"),
         ] {
-            let f = findings(
-                instruction,
-                &format!("objects: [(table, None, None)]\nplan:\nmove_to_object(get_obj(\"table\", {select}));"),
-            );
-            assert!(
-                f.iter().any(|x| x.kind == FindingKind::Word
-                    && x.to_model.contains("said no such count")
-                    && x.to_user.starts_with("which table do you mean? there are")),
-                "{instruction}: {f:?}"
-            );
+            let (found, f) = counted(instruction, select);
+            assert!(found, "{instruction}: {f:?}");
         }
         // Counts said as words, numbers, typos or "penultimate" pass, and so do the
         // first and the last, however said.
@@ -997,14 +1001,8 @@ mod tests {
             ("go to the table furthest away", "#{ordinal: -1}"),
             ("go to the closest table", "#{ordinal: 1}"),
         ] {
-            let f = findings(
-                instruction,
-                &format!("objects: [(table, None, None)]\nplan:\nmove_to_object(get_obj(\"table\", {select}));"),
-            );
-            assert!(
-                f.iter().all(|x| !x.to_model.contains("no such count")),
-                "{instruction} {select}: {f:?}"
-            );
+            let (found, f) = counted(instruction, select);
+            assert!(!found, "{instruction} {select}: {f:?}");
         }
         // In a conversation a count may follow from what was visited ("the next one").
         let m = map();
