@@ -88,6 +88,12 @@ pub struct PlanOptions {
     /// Send the grammar in Lark too, which the llama backend runs with llguidance
     /// instead of GBNF (default on; off measures GBNF).
     pub llguidance: bool,
+    /// Narrow the grammar's selections to what the person said (default on): colours
+    /// the instruction (or an object the conversation visited) names, counts it says
+    /// (outside a conversation; 1 and -1 always), directional orders only when it names
+    /// a side or a compass direction. What the checks would re-ask, the grammar
+    /// prevents; the checks stay for backends that take no grammar.
+    pub said_only: bool,
 }
 
 impl Default for PlanOptions {
@@ -100,6 +106,7 @@ impl Default for PlanOptions {
             examples: None,
             answer_grammar: true,
             llguidance: true,
+            said_only: true,
         }
     }
 }

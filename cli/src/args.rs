@@ -239,6 +239,10 @@ pub(crate) struct ModelArgs {
     /// (slower; for comparison).
     #[arg(long)]
     pub(crate) gbnf: bool,
+    /// Offer every colour, count and order of the map in the plan's selections, not
+    /// only those the instruction says (for comparison; the checks then re-ask).
+    #[arg(long)]
+    pub(crate) open_selections: bool,
 }
 
 impl ModelArgs {
@@ -266,6 +270,7 @@ impl ModelArgs {
             examples: self.examples,
             llguidance: !self.gbnf,
             answer_grammar: !self.no_grammar,
+            said_only: !self.open_selections,
             ..PlanOptions::default()
         }
     }

@@ -602,19 +602,7 @@ pub(crate) fn unsaid_colours<'a>(
     known: &[String],
     plan: &'a TypedPlan,
 ) -> Vec<(&'a Target, &'static str, &'a str)> {
-    let said: Vec<String> = words(instruction)
-        .iter()
-        .chain(known)
-        .filter_map(|w| normalise_colour(w))
-        .map(|c| canonical(&c))
-        .collect();
-    // A typed colour ("blak") says the colour it is one or two edits from.
-    let close = |c: &str| {
-        let limit = if c.chars().count() <= 5 { 1 } else { 2 };
-        said.iter()
-            .any(|w| w == c || strsim::damerau_levenshtein(w, c) <= limit)
-    };
-    let is_said = |c: &str| close(&canonical(c)) || words(c).iter().any(|w| close(&canonical(w)));
+    let is_said = colour_said(instruction, known);
     let mut out = Vec::new();
     for t in targets(plan) {
         for (field, c) in [("colour", &t.colour), ("not_colour", &t.not_colour)] {
@@ -624,6 +612,55 @@ pub(crate) fn unsaid_colours<'a>(
         }
     }
     out
+}
+
+/// Whether a colour is said by `instruction` or is one of the `known` colours (of what
+/// the conversation visited): a colour word of the instruction, a typed one ("blak")
+/// counting as the colour it is one or two edits from, grey as gray.
+pub(crate) fn colour_said<'a>(
+    instruction: &str,
+    known: &'a [String],
+) -> impl Fn(&str) -> bool + 'a {
+    let said: Vec<String> = words(instruction)
+        .iter()
+        .chain(known)
+        .filter_map(|w| normalise_colour(w))
+        .map(|c| canonical(&c))
+        .collect();
+    let close = move |c: &str| {
+        let limit = if c.chars().count() <= 5 { 1 } else { 2 };
+        said.iter()
+            .any(|w| w == c || strsim::damerau_levenshtein(w, c) <= limit)
+    };
+    move |c: &str| close(&canonical(c)) || words(c).iter().any(|w| close(&canonical(w)))
+}
+
+/// Whether a word of `instruction` names a side or a compass direction, which a
+/// directional order needs.
+pub(crate) fn direction_said(instruction: &str) -> bool {
+    let stems = ["north", "south", "east", "west", "left", "right"];
+    words(instruction)
+        .iter()
+        .any(|w| stems.iter().any(|s| w.starts_with(s)))
+}
+
+/// The counts `instruction` says ([`said_count`]: 3 for "third", "3rd", "thrid"; -2 for
+/// "penultimate").
+pub(crate) fn counts_said(instruction: &str) -> Vec<i64> {
+    words(instruction)
+        .iter()
+        .filter_map(|w| said_count(w))
+        .collect()
+}
+
+/// Whether an ordinal is said by the counts of [`counts_said`]: 1 and -1 always (the
+/// first and the last are said in too many ways), k and -k when k is said, -2 when
+/// "penultimate" is.
+pub(crate) fn ordinal_said(said: &[i64], ordinal: i64) -> bool {
+    ordinal.abs() <= 1
+        || said
+            .iter()
+            .any(|&k| k == ordinal.abs() || (k == -2 && ordinal == -2))
 }
 
 /// The unsaid colours ([`unsaid_colours`]) that change what the plan picks ("go to the
@@ -699,11 +736,7 @@ fn check_unsaid_colours(
 /// `#{ordinal: 3, order: "north_to_south"}`, seen on people.nav). No worked example may
 /// have one.
 pub(crate) fn unsaid_directions<'a>(instruction: &str, plan: &'a TypedPlan) -> Vec<&'a Target> {
-    let stems = ["north", "south", "east", "west", "left", "right"];
-    if words(instruction)
-        .iter()
-        .any(|w| stems.iter().any(|s| w.starts_with(s)))
-    {
+    if direction_said(instruction) {
         return Vec::new();
     }
     targets(plan)
@@ -736,18 +769,10 @@ pub(crate) fn unsaid_ordinals<'a>(
     if in_chat {
         return Vec::new();
     }
-    let said: Vec<i64> = words(instruction)
-        .iter()
-        .filter_map(|w| said_count(w))
-        .collect();
+    let said = counts_said(instruction);
     targets(plan)
         .into_iter()
-        .filter(|t| {
-            t.ordinal.abs() >= 2
-                && !said
-                    .iter()
-                    .any(|&k| k == t.ordinal.abs() || (k == -2 && t.ordinal == -2))
-        })
+        .filter(|t| !ordinal_said(&said, t.ordinal))
         .collect()
 }
 

@@ -26,6 +26,10 @@ pub struct Vocabulary {
     /// Object ids the plan may name with `get_instance` (what the conversation visited;
     /// empty outside a conversation).
     pub ids: Vec<u32>,
+    /// The ordinals a selection may count (`None`: any from -99 to 99 but 0).
+    pub ordinals: Option<Vec<i64>>,
+    /// Offer only the orders that name no direction (nearest, farthest, size first).
+    pub no_directions: bool,
 }
 
 impl Vocabulary {
@@ -53,6 +57,8 @@ impl Vocabulary {
             colours,
             regions,
             ids: Vec::new(),
+            ordinals: None,
+            no_directions: false,
         }
     }
 }
@@ -322,9 +328,32 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
             );
         }
     }
-    w.rule("qorder", &alt(&orders(true), true));
-    let int = w.pattern("\"-\"? [1-9] [0-9]?", "-?[1-9][0-9]?");
-    w.rule("int", &int);
+    let offered: Vec<&str> = orders(true)
+        .into_iter()
+        .filter(|o| {
+            !vocab.no_directions
+                || ObjectOrder::parse(o).is_ok_and(|o| {
+                    matches!(
+                        o,
+                        ObjectOrder::NearToFar
+                            | ObjectOrder::FarToNear
+                            | ObjectOrder::LargestToSmallest
+                            | ObjectOrder::SmallestToLargest
+                    )
+                })
+        })
+        .collect();
+    w.rule("qorder", &alt(&offered, true));
+    match vocab.ordinals.as_deref() {
+        Some(ks) if !ks.is_empty() => {
+            let ks: Vec<String> = ks.iter().map(i64::to_string).collect();
+            w.rule("int", &alt(&ks, false));
+        }
+        _ => {
+            let int = w.pattern("\"-\"? [1-9] [0-9]?", "-?[1-9][0-9]?");
+            w.rule("int", &int);
+        }
+    }
     let num = w.pattern(
         "\"-\"? [0-9] [0-9]{0,2} (\".\" [0-9] [0-9]?)?",
         "-?[0-9]{1,3}(\\.[0-9]{1,2})?",
@@ -348,7 +377,7 @@ mod tests {
             names: vec!["chair".into(), "sofa".into(), "couch".into()],
             colours: vec!["red".into(), "black".into()],
             regions: vec!["kitchen".into()],
-            ids: Vec::new(),
+            ..Vocabulary::default()
         }
     }
 

@@ -183,6 +183,32 @@ fn settle(findings: &[Finding]) -> Outcome {
     ))
 }
 
+/// Narrows `v` to what the person said ([`PlanOptions::said_only`](crate::PlanOptions)):
+/// the colours the instruction or a visited object names, the counts the instruction
+/// says (outside a conversation), directional orders only when it names a direction.
+/// The same tests as the checks' ([`check::colour_said`], [`check::counts_said`],
+/// [`check::direction_said`]), so the grammar never offers what a check would re-ask.
+fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>) {
+    let known: Vec<String> = ctx
+        .references
+        .iter()
+        .filter_map(|id| ctx.map.instance_by_id(*id))
+        .filter_map(|i| i.colour.clone())
+        .collect();
+    let said = check::colour_said(instruction, &known);
+    v.colours.retain(|c| said(c));
+    if ctx.references.is_empty() {
+        let counts = check::counts_said(instruction);
+        v.ordinals = Some(
+            (1..=20)
+                .flat_map(|k| [k, -k])
+                .filter(|&k| check::ordinal_said(&counts, k))
+                .collect(),
+        );
+    }
+    v.no_directions = !check::direction_said(instruction);
+}
+
 /// Plans one instruction with one model call (and at most one re-ask).
 ///
 /// # Errors
@@ -206,6 +232,9 @@ pub fn plan_instruction(
     let vocab = {
         let mut v = Vocabulary::for_map(ctx.map);
         v.ids.clone_from(&ctx.references);
+        if ctx.options.said_only {
+            narrow_to_words(&mut v, instruction, ctx);
+        }
         v
     };
     let grammar = ctx.options.answer_grammar.then(|| answer_grammar(&vocab));
@@ -253,4 +282,82 @@ pub fn plan_instruction(
         }
     }
     Ok(settle(&findings))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use map_core::{IvlMap, Scene};
+
+    fn map() -> IvlMap {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../examples/scenes/flat-a.scene.json"
+        );
+        IvlMap::from_scene(&Scene::from_path(path).unwrap())
+    }
+
+    fn narrowed(instruction: &str, references: &[u32]) -> Vocabulary {
+        let m = map();
+        let mut ctx = PlanContext::new(&m);
+        ctx.references = references.to_vec();
+        let mut v = Vocabulary::for_map(&m);
+        narrow_to_words(&mut v, instruction, &ctx);
+        v
+    }
+
+    #[test]
+    fn the_grammar_offers_only_what_the_person_said() {
+        let v = narrowed("go to the thrid red chair, then the blak sofa", &[]);
+        assert_eq!(v.colours, ["black", "red"]);
+        let ks = v.ordinals.clone().unwrap();
+        for k in [1, -1, 3, -3] {
+            assert!(ks.contains(&k), "{ks:?}");
+        }
+        assert!(!ks.contains(&2) && !ks.contains(&-2), "{ks:?}");
+        assert!(v.no_directions);
+        let g = answer_lark(&v);
+        // The plan's rules (the objects line stays free: extraction reads it).
+        let rule = |name: &str| {
+            g.lines()
+                .find(|l| l.starts_with(&format!("{name}:")))
+                .unwrap_or_default()
+                .to_string()
+        };
+        let (qorder, qcolour) = (rule("qorder"), rule("qcolour"));
+        assert!(
+            qorder.contains("far_to_near") && !qorder.contains("west_to_east"),
+            "{g}"
+        );
+        assert!(qcolour.contains("red") && !qcolour.contains("white"), "{g}");
+
+        // A direction, "penultimate", no colour at all.
+        let v = narrowed("counting from the west, the penultimate chair", &[]);
+        assert!(v.colours.is_empty(), "{:?}", v.colours);
+        assert!(!v.no_directions);
+        let ks = v.ordinals.unwrap();
+        assert!(ks.contains(&-2) && !ks.contains(&2), "{ks:?}");
+        for g in [
+            answer_lark(&Vocabulary {
+                ..narrowed("go to the chair", &[])
+            }),
+            answer_grammar(&narrowed("go to the chair", &[])),
+        ] {
+            assert!(!g.contains("\"colour: \""), "{g}");
+        }
+    }
+
+    #[test]
+    fn in_a_conversation_counts_stay_open_and_visited_colours_are_said() {
+        let m = map();
+        let red = m
+            .instances
+            .iter()
+            .find(|i| i.colour.as_deref() == Some("red"))
+            .unwrap()
+            .id;
+        let v = narrowed("now the other one", &[red]);
+        assert_eq!(v.colours, ["red"]);
+        assert_eq!(v.ordinals, None);
+    }
 }
