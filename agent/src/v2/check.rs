@@ -892,11 +892,12 @@ pub fn runtime_finding(message: &str, line: Option<&str>) -> Finding {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::v2::answer::parse_answer;
 
-    fn map() -> IvlMap {
+    /// flat-a, the map the checks' tests (and the grammar narrowing's) run on.
+    pub(crate) fn map() -> IvlMap {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../examples/scenes/flat-a.scene.json"

@@ -286,16 +286,8 @@ pub fn plan_instruction(
 
 #[cfg(test)]
 mod tests {
+    use super::check::tests::map;
     use super::*;
-    use map_core::{IvlMap, Scene};
-
-    fn map() -> IvlMap {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../examples/scenes/flat-a.scene.json"
-        );
-        IvlMap::from_scene(&Scene::from_path(path).unwrap())
-    }
 
     fn narrowed(instruction: &str, references: &[u32]) -> Vocabulary {
         let m = map();
