@@ -184,19 +184,18 @@ fn settle(findings: &[Finding]) -> Outcome {
 }
 
 /// Narrows `v` to what the person said ([`PlanOptions::said_only`](crate::PlanOptions)):
-/// the colours the instruction or a visited object names, the counts the instruction
-/// says (outside a conversation), directional orders only when it names a direction.
-/// The same tests as the checks' ([`check::colour_said`], [`check::counts_said`],
-/// [`check::direction_said`]), so the grammar never offers what a check would re-ask.
+/// the counts the instruction says (outside a conversation), directional orders only
+/// when it names a direction. The same tests as the checks' ([`check::counts_said`],
+/// [`check::direction_said`]), so the grammar never offers what those checks would
+/// re-ask.
+///
+/// Colours are not narrowed: measured on people.nav, the default model gives most
+/// objects a colour, and with only the said colours on offer it gave them a said colour
+/// of another object ("the lamp" as a black lamp after "the black sofa", on a map whose
+/// one lamp is white): four plans became questions while four others were gained. A
+/// colour narrowed per object (the said colours that object has on this map) would
+/// need one selection rule per colour set; until then the checks judge colours.
 fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>) {
-    let known: Vec<String> = ctx
-        .references
-        .iter()
-        .filter_map(|id| ctx.map.instance_by_id(*id))
-        .filter_map(|i| i.colour.clone())
-        .collect();
-    let said = check::colour_said(instruction, &known);
-    v.colours.retain(|c| said(c));
     if ctx.references.is_empty() {
         let counts = check::counts_said(instruction);
         v.ordinals = Some(
@@ -299,57 +298,44 @@ mod tests {
     }
 
     #[test]
-    fn the_grammar_offers_only_what_the_person_said() {
-        let v = narrowed("go to the thrid red chair, then the blak sofa", &[]);
-        assert_eq!(v.colours, ["black", "red"]);
+    fn the_grammar_offers_only_the_counts_and_directions_the_person_said() {
+        let v = narrowed("go to the thrid red chair, then the black sofa", &[]);
         let ks = v.ordinals.clone().unwrap();
         for k in [1, -1, 3, -3] {
             assert!(ks.contains(&k), "{ks:?}");
         }
         assert!(!ks.contains(&2) && !ks.contains(&-2), "{ks:?}");
         assert!(v.no_directions);
-        let g = answer_lark(&v);
-        // The plan's rules (the objects line stays free: extraction reads it).
-        let rule = |name: &str| {
-            g.lines()
-                .find(|l| l.starts_with(&format!("{name}:")))
-                .unwrap_or_default()
-                .to_string()
-        };
-        let (qorder, qcolour) = (rule("qorder"), rule("qcolour"));
-        assert!(
-            qorder.contains("far_to_near") && !qorder.contains("west_to_east"),
-            "{g}"
-        );
-        assert!(qcolour.contains("red") && !qcolour.contains("white"), "{g}");
+        // Colours stay the map's (the checks judge them).
+        assert_eq!(v.colours, Vocabulary::for_map(&map()).colours);
+        for g in [answer_lark(&v), answer_grammar(&v)] {
+            // The plan's rules (the objects line stays free: extraction reads it).
+            let rule = |name: &str| {
+                g.lines()
+                    .find(|l| {
+                        l.starts_with(&format!("{name}:")) || l.starts_with(&format!("{name} ::="))
+                    })
+                    .unwrap_or_default()
+                    .to_string()
+            };
+            let (qorder, int) = (rule("qorder"), rule("int"));
+            assert!(
+                qorder.contains("far_to_near") && !qorder.contains("west_to_east"),
+                "{g}"
+            );
+            assert!(int.contains("\"-3\"") && !int.contains("\"2\""), "{g}");
+        }
 
-        // A direction, "penultimate", no colour at all.
+        // A direction and "penultimate".
         let v = narrowed("counting from the west, the penultimate chair", &[]);
-        assert!(v.colours.is_empty(), "{:?}", v.colours);
         assert!(!v.no_directions);
         let ks = v.ordinals.unwrap();
         assert!(ks.contains(&-2) && !ks.contains(&2), "{ks:?}");
-        for g in [
-            answer_lark(&Vocabulary {
-                ..narrowed("go to the chair", &[])
-            }),
-            answer_grammar(&narrowed("go to the chair", &[])),
-        ] {
-            assert!(!g.contains("\"colour: \""), "{g}");
-        }
     }
 
     #[test]
-    fn in_a_conversation_counts_stay_open_and_visited_colours_are_said() {
-        let m = map();
-        let red = m
-            .instances
-            .iter()
-            .find(|i| i.colour.as_deref() == Some("red"))
-            .unwrap()
-            .id;
-        let v = narrowed("now the other one", &[red]);
-        assert_eq!(v.colours, ["red"]);
+    fn in_a_conversation_counts_stay_open() {
+        let v = narrowed("now the next one", &[1]);
         assert_eq!(v.ordinals, None);
     }
 }
