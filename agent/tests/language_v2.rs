@@ -184,13 +184,14 @@ fn a_map_error_in_the_dry_run_is_asked_about() {
 #[test]
 fn no_rule_changes_a_typed_answer() {
     // Answers the checks accept, including readings a word table would "correct" (the
-    // person's own word "couch" in the objects line, an ordinal the words do not state):
+    // person's own word "couch" in the objects line, "the second chair from the end" as
+    // ordinal -2 where a word table would read 2):
     // what runs is the model's plan, printed canonically, and its tuples unchanged.
     let map = flat_a();
     let robot = SimRobot::new(map.clone());
     let cases = [
         ("go to the couch", "objects: [(couch, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\n"),
-        ("go to the chair", "objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2}));\n"),
+        ("go to the second chair from the end", "objects: [(chair, 2, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: -2}));\n"),
         (
             "go to the plant that is farthest from you",
             "objects: [(plant, last, None)]\nplan:\nmove_to_object(get_obj(\"plant\", #{ordinal: -1}));\n",
