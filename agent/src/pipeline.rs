@@ -88,11 +88,11 @@ pub struct PlanOptions {
     /// Send the grammar in Lark too, which the llama backend runs with llguidance
     /// instead of GBNF (default on; off measures GBNF).
     pub llguidance: bool,
-    /// Narrow the grammar's selections to what the person said (default on): colours
-    /// the instruction (or an object the conversation visited) names, counts it says
-    /// (outside a conversation; 1 and -1 always), directional orders only when it names
-    /// a side or a compass direction. What the checks would re-ask, the grammar
-    /// prevents; the checks stay for backends that take no grammar.
+    /// Narrow the grammar's selections to what the person said (default on): counts
+    /// the instruction says (outside a conversation; 1 and -1 always), directional
+    /// orders only when it names a side or a compass direction. What those checks would
+    /// re-ask, the grammar prevents; the checks stay for backends that take no grammar.
+    /// Colours are not narrowed (see `v2::narrow_to_words`).
     pub said_only: bool,
 }
 

@@ -486,18 +486,12 @@ pub fn said_count(word: &str) -> Option<i64> {
     if w.chars().count() < 5 {
         return None;
     }
-    ORDINAL_WORDS
-        .iter()
-        .chain(CARDINAL_WORDS)
-        .position(|o| strsim::damerau_levenshtein(o, &w) <= 1)
-        .map(|i| {
-            let i = i as i64;
-            if i < ORDINAL_WORDS.len() as i64 {
-                i + 1
-            } else {
-                i - ORDINAL_WORDS.len() as i64 + 1
-            }
-        })
+    let near = |list: &[&str]| {
+        list.iter()
+            .position(|o| strsim::damerau_levenshtein(o, &w) <= 1)
+            .map(|i| i as i64 + 1)
+    };
+    near(ORDINAL_WORDS).or_else(|| near(CARDINAL_WORDS))
 }
 
 /// Superlatives that are the first in some order ("westernmost" = 1st from west to east).

@@ -239,8 +239,8 @@ pub(crate) struct ModelArgs {
     /// (slower; for comparison).
     #[arg(long)]
     pub(crate) gbnf: bool,
-    /// Offer every colour, count and order of the map in the plan's selections, not
-    /// only those the instruction says (for comparison; the checks then re-ask).
+    /// Offer every count and order in the plan's selections, not only those the
+    /// instruction says (for comparison; the checks then re-ask).
     #[arg(long)]
     pub(crate) open_selections: bool,
 }

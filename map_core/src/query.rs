@@ -68,6 +68,19 @@ impl ObjectOrder {
             })
     }
 
+    /// Whether the order counts along a direction (a compass direction or a side), not
+    /// by distance or size.
+    #[must_use]
+    pub fn is_directional(self) -> bool {
+        !matches!(
+            self,
+            ObjectOrder::NearToFar
+                | ObjectOrder::FarToNear
+                | ObjectOrder::LargestToSmallest
+                | ObjectOrder::SmallestToLargest
+        )
+    }
+
     /// The same ranking counted from the other end ("the second to last from the
     /// west" is the 2nd in `east_to_west`).
     #[must_use]

@@ -741,15 +741,7 @@ pub(crate) fn unsaid_directions<'a>(instruction: &str, plan: &'a TypedPlan) -> V
     }
     targets(plan)
         .into_iter()
-        .filter(|t| {
-            !matches!(
-                t.order,
-                ObjectOrder::NearToFar
-                    | ObjectOrder::FarToNear
-                    | ObjectOrder::LargestToSmallest
-                    | ObjectOrder::SmallestToLargest
-            )
-        })
+        .filter(|t| t.order.is_directional())
         .collect()
 }
 

@@ -331,16 +331,7 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
     let offered: Vec<&str> = orders(true)
         .into_iter()
         .filter(|o| {
-            !vocab.no_directions
-                || ObjectOrder::parse(o).is_ok_and(|o| {
-                    matches!(
-                        o,
-                        ObjectOrder::NearToFar
-                            | ObjectOrder::FarToNear
-                            | ObjectOrder::LargestToSmallest
-                            | ObjectOrder::SmallestToLargest
-                    )
-                })
+            !vocab.no_directions || ObjectOrder::parse(o).is_ok_and(|o| !o.is_directional())
         })
         .collect();
     w.rule("qorder", &alt(&offered, true));
