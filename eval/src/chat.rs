@@ -123,6 +123,7 @@ pub fn run_dialogue(
         instruction: None,
         trajectory: Some(robot.trajectory().clone()),
         reached: None,
+        reasks: None,
         turns: Some(turns),
     }
 }

@@ -25,7 +25,7 @@ use planner_dsl::{Limits, Plan};
 
 use agent::extract_tuples;
 use agent::tuples::same_tuples;
-use agent::{plan_instruction, Outcome, PlanContext, PlanOptions, Prompts, Tuple};
+use agent::{plan_instruction, Outcome, PlanContext, PlanOptions, PlanSource, Prompts, Tuple};
 use llm::LlmBackend;
 
 use crate::baseline::vlmap_script;
@@ -84,6 +84,7 @@ pub fn run_extract(
                     trajectory: None,
                     reached: None,
                     turns: None,
+                    reasks: None,
                 },
                 Err(e) => CaseResult {
                     id: c.id.clone(),
@@ -95,6 +96,7 @@ pub fn run_extract(
                     trajectory: None,
                     reached: None,
                     turns: None,
+                    reasks: None,
                 },
             };
             on_case(&res);
@@ -107,6 +109,8 @@ pub fn run_extract(
 struct Planned {
     tuples: Option<Vec<Tuple>>,
     plan: Result<Plan, String>,
+    /// Re-asks the language layer made (`None` without a model).
+    reasks: Option<u32>,
 }
 
 fn plan_task(
@@ -125,22 +129,26 @@ fn plan_task(
                 Some(src) => Plan::compile(src).map_err(|e| format!("reference plan: {e}")),
                 None => Err(format!("task {} has no \"reference\" plan", task.id)),
             },
+            reasks: None,
         },
         Method::Vlmap => {
             let Some(b) = backend else {
                 return Planned {
                     tuples: None,
                     plan: Err(need()),
+                    reasks: None,
                 };
             };
             match extract_tuples(b, prompts, &task.instruction, options) {
                 Ok((tuples, _)) => Planned {
                     plan: Plan::compile(&vlmap_script(&tuples)).map_err(|e| e.to_string()),
                     tuples: Some(tuples),
+                    reasks: None,
                 },
                 Err(e) => Planned {
                     tuples: None,
                     plan: Err(e.to_string()),
+                    reasks: None,
                 },
             }
         }
@@ -149,6 +157,7 @@ fn plan_task(
                 return Planned {
                     tuples: None,
                     plan: Err(need()),
+                    reasks: None,
                 };
             };
             let mut ctx = PlanContext::new(&task.map).with_robot(robot);
@@ -157,18 +166,26 @@ fn plan_task(
                 Ok(Outcome::Plan(p)) => Planned {
                     tuples: Some(p.tuples.clone()),
                     plan: Ok(p.plan.clone()),
+                    reasks: Some(match p.source {
+                        PlanSource::Llm { repairs } => repairs,
+                    }),
                 },
+                // A question or refusal comes when the answer after the re-ask (if
+                // re-asks are on) still disagrees.
                 Ok(Outcome::Question(q)) => Planned {
                     tuples: None,
                     plan: Err(format!("asked a question instead of planning: {q}")),
+                    reasks: Some(u32::from(options.reask)),
                 },
                 Ok(Outcome::Refusal(r)) => Planned {
                     tuples: None,
                     plan: Err(format!("refused: {r}")),
+                    reasks: Some(u32::from(options.reask)),
                 },
                 Err(e) => Planned {
                     tuples: None,
                     plan: Err(e.to_string()),
+                    reasks: None,
                 },
             }
         }
@@ -234,6 +251,7 @@ pub fn run_task(
         trajectory: Some(trajectory),
         reached: Some(reached),
         turns: None,
+        reasks: planned.reasks,
     }
 }
 

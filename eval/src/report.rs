@@ -34,6 +34,10 @@ pub struct CaseResult {
     /// Chat: one result per turn, in order.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub turns: Option<Vec<crate::chat::TurnResult>>,
+    /// Navigation with a model: the re-asks the language layer made for this case (a
+    /// question or refusal comes after one); additive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reasks: Option<u32>,
 }
 
 /// The report's summary.
@@ -61,6 +65,10 @@ pub struct Summary {
     /// Chat: share of dialogues whose every turn was.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dialogue_success: Option<f64>,
+    /// Share of the cases that report `reasks` whose first answer did not stand (a
+    /// re-ask was made); additive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reask_rate: Option<f64>,
 }
 
 /// The report file of formats.md.
@@ -154,6 +162,9 @@ pub fn summarise(cases: &[CaseResult]) -> Summary {
         .flatten()
         .collect();
     let chat = (!turns.is_empty()).then(|| (turns.iter().filter(|t| t.ok()).count(), turns.len()));
+    let reasks: Vec<u32> = cases.iter().filter_map(|c| c.reasks).collect();
+    let reask_rate = (!reasks.is_empty())
+        .then(|| ratio(reasks.iter().filter(|&&k| k > 0).count(), reasks.len()));
     Summary {
         total: cases.len(),
         ok,
@@ -164,6 +175,7 @@ pub fn summarise(cases: &[CaseResult]) -> Summary {
         sr: nav.map(|n| n.sr),
         turn_accuracy: chat.map(|(ok, n)| ratio(ok, n)),
         dialogue_success: chat.map(|_| ratio(ok, cases.len())),
+        reask_rate,
     }
 }
 
@@ -233,6 +245,7 @@ pub fn summary_table(reports: &[Report]) -> String {
             (|r: &Report| r.summary.turn_accuracy) as fn(&Report) -> Option<f64>,
         ),
         ("dialogue success", |r: &Report| r.summary.dialogue_success),
+        ("re-asked", |r: &Report| r.summary.reask_rate),
     ] {
         if reports.iter().any(|r| get(r).is_some()) {
             rows.push((
@@ -299,7 +312,34 @@ mod tests {
             trajectory: None,
             reached,
             turns: None,
+            reasks: None,
         }
+    }
+
+    #[test]
+    fn the_reask_rate_counts_cases_whose_first_answer_did_not_stand() {
+        let mut cases: Vec<CaseResult> = (0..4)
+            .map(|i| case(&format!("n{i}"), true, 1, Some(vec![true])))
+            .collect();
+        assert_eq!(summarise(&cases).reask_rate, None, "no model, no rate");
+        for (c, k) in cases.iter_mut().zip([0, 1, 0, 0]) {
+            c.reasks = Some(k);
+        }
+        let s = summarise(&cases);
+        assert_eq!(s.reask_rate, Some(0.25));
+        let table = summary_table(&[Report {
+            suite: "x.nav.jsonl".into(),
+            backend: "llama".into(),
+            model: "m.gguf".into(),
+            prompts: "builtin".into(),
+            method: None,
+            cases,
+            summary: s,
+        }]);
+        assert!(
+            table.contains("re-asked") && table.contains("0.250"),
+            "{table}"
+        );
     }
 
     #[test]
