@@ -92,8 +92,11 @@ pub struct PlanOptions {
     /// the instruction says (outside a conversation; 1 and -1 always), directional
     /// orders only when it names a side or a compass direction. What those checks would
     /// re-ask, the grammar prevents; the checks stay for backends that take no grammar.
-    /// Colours are not narrowed (see `v2::narrow_to_words`).
+    /// Colours are narrowed only with `said_colours`.
     pub said_only: bool,
+    /// With `said_only`, outside a conversation: a pick of each object may select only
+    /// on the colours the person said that some object of that name has on this map.
+    pub said_colours: bool,
 }
 
 impl Default for PlanOptions {
@@ -107,6 +110,7 @@ impl Default for PlanOptions {
             answer_grammar: true,
             llguidance: true,
             said_only: true,
+            said_colours: false,
         }
     }
 }

@@ -243,6 +243,10 @@ pub(crate) struct ModelArgs {
     /// instruction says (for comparison; the checks then re-ask).
     #[arg(long)]
     pub(crate) open_selections: bool,
+    /// Narrow each pick's colours to those the person said that an object of that name
+    /// has on the map (outside a conversation; for comparison).
+    #[arg(long, conflicts_with = "open_selections")]
+    pub(crate) said_colours: bool,
 }
 
 impl ModelArgs {
@@ -271,6 +275,7 @@ impl ModelArgs {
             llguidance: !self.gbnf,
             answer_grammar: !self.no_grammar,
             said_only: !self.open_selections,
+            said_colours: self.said_colours,
             ..PlanOptions::default()
         }
     }

@@ -30,6 +30,10 @@ pub struct Vocabulary {
     pub ordinals: Option<Vec<i64>>,
     /// Offer only the orders that name no direction (nearest, farthest, size first).
     pub no_directions: bool,
+    /// The colours a pick of each name may select on (`colour` and `not_colour`), as
+    /// groups of names sharing one colour list (`None`: every name any of `colours`).
+    /// A group with no colours picks that name without a colour key.
+    pub colours_of: Option<Vec<(Vec<String>, Vec<String>)>>,
 }
 
 impl Vocabulary {
@@ -59,6 +63,7 @@ impl Vocabulary {
             ids: Vec::new(),
             ordinals: None,
             no_directions: false,
+            colours_of: None,
         }
     }
 }
@@ -236,6 +241,39 @@ fn call_rule(name: &str) -> Option<String> {
     Some(r)
 }
 
+/// The selection map `selmap{suffix}`: its keys in a fixed order, each optional, at
+/// least one; colours from the rule `colour` (none: no colour keys).
+fn selection_rules(w: &mut Writer, suffix: &str, colour: Option<&str>, vocab: &Vocabulary) {
+    let mut keys = vec!["\"ordinal: \" int".to_string()];
+    if let Some(c) = colour {
+        keys.push(format!("\"colour: \" {c}"));
+        keys.push(format!("\"not_colour: \" {c}"));
+    }
+    keys.push("\"order: \" qorder".into());
+    if !vocab.regions.is_empty() {
+        keys.push("\"region: \" qregion".into());
+    }
+    keys.push("\"near: \" obj".into());
+    w.rule(
+        &format!("selmap{suffix}"),
+        &format!("\"#{{\" sel{suffix}_0 \"}}\""),
+    );
+    let n = keys.len();
+    for (i, k) in keys.iter().enumerate() {
+        if i + 1 == n {
+            w.rule(&format!("sel{suffix}_{i}"), k);
+        } else {
+            w.rule(
+                &format!("sel{suffix}_{i}"),
+                &format!(
+                    "{k} (\", \" sel{suffix}_{next})? | sel{suffix}_{next}",
+                    next = i + 1
+                ),
+            );
+        }
+    }
+}
+
 /// GBNF for the whole answer: the objects line, `plan:`, then one typed step per line,
 /// with names, colours and regions from `vocab`. Rule `root`.
 ///
@@ -271,13 +309,22 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
     w.rule("step", &format!("({}) \";\"", steps.join(" | ")));
     let var = w.pattern("[a-z] [a-z0-9_]{0,15}", "[a-z][a-z0-9_]{0,15}");
     w.rule("var", &var);
-    w.rule(
-        "pick",
-        &format!(
-            "{} pname (\", \" selmap)? \")\"",
-            q(&format!("{PICK_FUNCTION}("))
-        ),
-    );
+    let get = q(&format!("{PICK_FUNCTION}("));
+    match &vocab.colours_of {
+        // One pick rule per group of names, each with its own colour list.
+        Some(groups) if !groups.is_empty() => {
+            let mut picks = Vec::new();
+            for (g, (names, _)) in groups.iter().enumerate() {
+                w.rule(
+                    &format!("pick{g}"),
+                    &format!("{get} ({}) (\", \" selmap{g})? \")\"", alt(names, true)),
+                );
+                picks.push(format!("pick{g}"));
+            }
+            w.rule("pick", &picks.join(" | "));
+        }
+        _ => w.rule("pick", &format!("{get} pname (\", \" selmap)? \")\"")),
+    }
     if vocab.ids.is_empty() {
         w.rule("obj", "pick | qname | var");
     } else {
@@ -303,30 +350,24 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
     } else {
         w.rule("qname", &format!("pname | {}", alt(&vocab.regions, true)));
     }
-    // The selection map's keys in a fixed order, each optional, at least one.
-    let mut keys = vec!["\"ordinal: \" int".to_string()];
     if !vocab.colours.is_empty() {
-        keys.push("\"colour: \" qcolour".into());
-        keys.push("\"not_colour: \" qcolour".into());
         w.rule("qcolour", &alt(&vocab.colours, true));
     }
-    keys.push("\"order: \" qorder".into());
     if !vocab.regions.is_empty() {
-        keys.push("\"region: \" qregion".into());
         w.rule("qregion", &alt(&vocab.regions, true));
     }
-    keys.push("\"near: \" obj".into());
-    w.rule("selmap", "\"#{\" sel0 \"}\"");
-    let n = keys.len();
-    for (i, k) in keys.iter().enumerate() {
-        if i + 1 == n {
-            w.rule(&format!("sel{i}"), k);
-        } else {
-            w.rule(
-                &format!("sel{i}"),
-                &format!("{k} (\", \" sel{next})? | sel{next}", next = i + 1),
-            );
-        }
+    selection_rules(
+        &mut w,
+        "",
+        (!vocab.colours.is_empty()).then_some("qcolour"),
+        vocab,
+    );
+    for (g, (_, colours)) in vocab.colours_of.iter().flatten().enumerate() {
+        let rule = (!colours.is_empty()).then(|| {
+            w.rule(&format!("qcolour{g}"), &alt(colours, true));
+            format!("qcolour{g}")
+        });
+        selection_rules(&mut w, &g.to_string(), rule.as_deref(), vocab);
     }
     let offered: Vec<&str> = orders(true)
         .into_iter()
@@ -412,7 +453,7 @@ mod tests {
         assert!(!g.contains("\"\\\"yellow\\\"\""), "a colour the map lacks");
         // Every rule used is defined.
         for rule in [
-            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel0",
+            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel_0",
             "qcolour", "qregion", "qorder", "int", "num", "pos", "text", "var",
         ] {
             assert!(g.contains(&format!("\n{rule} ::=")), "{rule}");
@@ -425,7 +466,7 @@ mod tests {
         assert!(g.starts_with("start: objects"), "{g}");
         assert!(!g.contains("::="), "{g}");
         for rule in [
-            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel0",
+            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel_0",
             "qcolour", "qregion", "qorder", "int", "num", "pos", "text", "var",
         ] {
             assert!(g.contains(&format!("\n{rule}: ")), "{rule}");

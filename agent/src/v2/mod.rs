@@ -204,8 +204,46 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
                 .filter(|&k| check::ordinal_said(&counts, k))
                 .collect(),
         );
+        if ctx.options.said_colours {
+            v.colours_of = Some(colours_said_of(ctx.map, instruction));
+        }
     }
     v.no_directions = !check::direction_said(instruction);
+}
+
+/// Per object name, the colours the person said that some object of that name has on
+/// this map ([`check::colour_said`]: a typo counts), as groups of names (a label and its
+/// synonyms) sharing one list; a name's first group wins.
+fn colours_said_of(map: &map_core::IvlMap, instruction: &str) -> Vec<(Vec<String>, Vec<String>)> {
+    let said = check::colour_said(instruction, &[]);
+    let mut groups: Vec<(Vec<String>, Vec<String>)> = Vec::new();
+    let mut seen: Vec<String> = Vec::new();
+    for (label, _) in map.label_counts() {
+        let mut colours: Vec<String> = map
+            .instances
+            .iter()
+            .filter(|i| i.label == label)
+            .filter_map(|i| i.colour.clone())
+            .filter(|c| said(c))
+            .collect();
+        colours.sort();
+        colours.dedup();
+        let mut names: Vec<String> = map_core::matcher::synonyms(&label)
+            .into_iter()
+            .map(str::to_string)
+            .collect();
+        names.push(label);
+        names.retain(|n| !n.trim().is_empty() && !seen.contains(n));
+        seen.extend(names.iter().cloned());
+        if names.is_empty() {
+            continue;
+        }
+        match groups.iter_mut().find(|(_, c)| *c == colours) {
+            Some((n, _)) => n.extend(names),
+            None => groups.push((names, colours)),
+        }
+    }
+    groups
 }
 
 /// Plans one instruction with one model call (and at most one re-ask).
@@ -331,6 +369,58 @@ mod tests {
         assert!(!v.no_directions);
         let ks = v.ordinals.unwrap();
         assert!(ks.contains(&-2) && !ks.contains(&2), "{ks:?}");
+    }
+
+    #[test]
+    fn with_said_colours_each_pick_offers_the_said_colours_its_objects_have() {
+        let m = map();
+        let mut ctx = PlanContext::new(&m);
+        ctx.options.said_colours = true;
+        let mut v = Vocabulary::for_map(&m);
+        narrow_to_words(
+            &mut v,
+            "go to the blak chair, then the red sofa and the plant",
+            &ctx,
+        );
+        let groups = v.colours_of.clone().unwrap();
+        let of = |name: &str| {
+            groups
+                .iter()
+                .find(|(n, _)| n.iter().any(|x| x == name))
+                .map(|(_, c)| c.clone())
+                .unwrap_or_else(|| panic!("{name}: {groups:?}"))
+        };
+        // A typo counts; only colours the map has for that name.
+        assert_eq!(of("chair"), ["black", "red"]);
+        assert_eq!(of("sofa"), ["black", "red"]);
+        assert_eq!(of("desk"), ["black"]);
+        assert!(of("plant").is_empty() && of("tv") == ["black"]);
+        // Synonyms travel with their label.
+        assert_eq!(of("couch"), of("sofa"));
+        for g in [answer_lark(&v), answer_grammar(&v)] {
+            let pick = g
+                .lines()
+                .find(|l| l.contains("\"\\\"plant\\\"\""))
+                .unwrap_or_default();
+            let k = pick
+                .split(['p', ':', ' '])
+                .find_map(|w| w.strip_prefix("ick"));
+            assert!(k.is_some(), "{pick}");
+            let sel = format!("sel{}_1", k.unwrap());
+            let rule = g
+                .lines()
+                .find(|l| l.starts_with(&format!("{sel}:")) || l.starts_with(&format!("{sel} ::=")))
+                .unwrap_or_default();
+            assert!(
+                !rule.contains("colour"),
+                "plants: no colour key: {rule}\n{g}"
+            );
+        }
+        // Without the option, colours are open.
+        ctx.options.said_colours = false;
+        let mut v = Vocabulary::for_map(&m);
+        narrow_to_words(&mut v, "go to the red sofa", &ctx);
+        assert_eq!(v.colours_of, None);
     }
 
     #[test]
