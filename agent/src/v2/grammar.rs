@@ -242,7 +242,9 @@ fn call_rule(name: &str) -> Option<String> {
 }
 
 /// The selection map `selmap{suffix}`: its keys in a fixed order, each optional, at
-/// least one; colours from the rule `colour` (none: no colour keys).
+/// least one; colours from the rule `colour` (none: no colour keys). Its key rules are
+/// `sel0`, `sel1`... without a suffix (the names recorded cassettes hold) and
+/// `sel{suffix}_0`... with one.
 fn selection_rules(w: &mut Writer, suffix: &str, colour: Option<&str>, vocab: &Vocabulary) {
     let mut keys = vec!["\"ordinal: \" int".to_string()];
     if let Some(c) = colour {
@@ -254,21 +256,25 @@ fn selection_rules(w: &mut Writer, suffix: &str, colour: Option<&str>, vocab: &V
         keys.push("\"region: \" qregion".into());
     }
     keys.push("\"near: \" obj".into());
+    let sel = |i: usize| {
+        if suffix.is_empty() {
+            format!("sel{i}")
+        } else {
+            format!("sel{suffix}_{i}")
+        }
+    };
     w.rule(
         &format!("selmap{suffix}"),
-        &format!("\"#{{\" sel{suffix}_0 \"}}\""),
+        &format!("\"#{{\" {} \"}}\"", sel(0)),
     );
     let n = keys.len();
     for (i, k) in keys.iter().enumerate() {
         if i + 1 == n {
-            w.rule(&format!("sel{suffix}_{i}"), k);
+            w.rule(&sel(i), k);
         } else {
             w.rule(
-                &format!("sel{suffix}_{i}"),
-                &format!(
-                    "{k} (\", \" sel{suffix}_{next})? | sel{suffix}_{next}",
-                    next = i + 1
-                ),
+                &sel(i),
+                &format!("{k} (\", \" {next})? | {next}", next = sel(i + 1)),
             );
         }
     }
@@ -453,7 +459,7 @@ mod tests {
         assert!(!g.contains("\"\\\"yellow\\\"\""), "a colour the map lacks");
         // Every rule used is defined.
         for rule in [
-            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel_0",
+            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel0",
             "qcolour", "qregion", "qorder", "int", "num", "pos", "text", "var",
         ] {
             assert!(g.contains(&format!("\n{rule} ::=")), "{rule}");
@@ -466,7 +472,7 @@ mod tests {
         assert!(g.starts_with("start: objects"), "{g}");
         assert!(!g.contains("::="), "{g}");
         for rule in [
-            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel_0",
+            "objects", "tuple", "stmt", "step", "pick", "obj", "qname", "pname", "selmap", "sel0",
             "qcolour", "qregion", "qorder", "int", "num", "pos", "text", "var",
         ] {
             assert!(g.contains(&format!("\n{rule}: ")), "{rule}");

@@ -178,7 +178,11 @@ impl Api {
         let res = self
             .auth(
                 self.http
-                    .get(self.url(&format!("/api/sessions/{id}/events"))),
+                    .get(self.url(&format!("/api/sessions/{id}/events")))
+                    // The stream stays open while a whole recording runs (measured over
+                    // the client's 600 s on a loaded 2-core machine: the body read then
+                    // failed and no event came back); each read has its own deadline.
+                    .timeout(Duration::from_secs(3600)),
             )
             .send()
             .await
