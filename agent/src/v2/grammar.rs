@@ -36,14 +36,21 @@ pub struct Vocabulary {
     pub colours_of: Option<Vec<(Vec<String>, Vec<String>)>>,
 }
 
+/// The names a label goes by in a plan: its synonyms, then the label (blank ones left out).
+pub(crate) fn label_names(label: String) -> Vec<String> {
+    let mut names: Vec<String> = synonyms(&label).into_iter().map(str::to_string).collect();
+    names.push(label);
+    names.retain(|n| !n.trim().is_empty());
+    names
+}
+
 impl Vocabulary {
     /// The vocabulary of `map`, sorted and without duplicates.
     #[must_use]
     pub fn for_map(map: &IvlMap) -> Self {
         let mut names = Vec::new();
         for (label, _) in map.label_counts() {
-            names.extend(synonyms(&label).into_iter().map(str::to_string));
-            names.push(label);
+            names.extend(label_names(label));
         }
         let mut colours: Vec<String> = map
             .instances
@@ -362,12 +369,15 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
     if !vocab.regions.is_empty() {
         w.rule("qregion", &alt(&vocab.regions, true));
     }
-    selection_rules(
-        &mut w,
-        "",
-        (!vocab.colours.is_empty()).then_some("qcolour"),
-        vocab,
-    );
+    // The shared selection map, unless every pick has its group's own.
+    if vocab.colours_of.as_ref().is_none_or(Vec::is_empty) {
+        selection_rules(
+            &mut w,
+            "",
+            (!vocab.colours.is_empty()).then_some("qcolour"),
+            vocab,
+        );
+    }
     for (g, (_, colours)) in vocab.colours_of.iter().flatten().enumerate() {
         let rule = (!colours.is_empty()).then(|| {
             w.rule(&format!("qcolour{g}"), &alt(colours, true));

@@ -30,7 +30,9 @@ use crate::tuples::{parse_tuples, Tuple};
 
 use self::answer::{objects_part, parse_answer, Answer};
 use self::check::{check_answer, runtime_finding, Finding, FindingKind};
-use self::grammar::{answer_grammar, answer_lark, objects_grammar, objects_lark, Vocabulary};
+use self::grammar::{
+    answer_grammar, answer_lark, label_names, objects_grammar, objects_lark, Vocabulary,
+};
 
 /// The messages of one request: system (+ scene), the nearest worked examples, the
 /// instruction. With `k` = `None` every worked example follows the system message instead and
@@ -228,12 +230,8 @@ fn colours_said_of(map: &map_core::IvlMap, instruction: &str) -> Vec<(Vec<String
             .collect();
         colours.sort();
         colours.dedup();
-        let mut names: Vec<String> = map_core::matcher::synonyms(&label)
-            .into_iter()
-            .map(str::to_string)
-            .collect();
-        names.push(label);
-        names.retain(|n| !n.trim().is_empty() && !seen.contains(n));
+        let mut names = label_names(label);
+        names.retain(|n| !seen.contains(n));
         seen.extend(names.iter().cloned());
         if names.is_empty() {
             continue;
