@@ -100,7 +100,12 @@ impl ChatMessage {
 /// What to ask a backend for. Serializable, so that cassettes can key on it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CompletionRequest {
-    /// The chat so far; the model answers as the assistant.
+    /// The chat so far; the model answers as the assistant. A final assistant message
+    /// (after at least one other) is the beginning of the answer, which the model
+    /// continues: the llama backend opens the assistant turn and appends it; the openai
+    /// backend sends it as it is (a server that takes an assistant prefill continues it;
+    /// one that does not starts a new answer). The completion's text is only what
+    /// follows it.
     pub messages: Vec<ChatMessage>,
     /// The most tokens to generate.
     pub max_tokens: u32,

@@ -37,7 +37,7 @@ use llama_cpp_2::sampling::LlamaSampler;
 use llama_cpp_2::token::LlamaToken;
 use llama_cpp_2::{ChatTemplateError, LogOptions};
 
-use super::{ChatMessage, Completion, CompletionRequest, FinishReason, LlmBackend, LlmError};
+use super::{ChatMessage, Completion, CompletionRequest, FinishReason, LlmBackend, LlmError, Role};
 
 mod disk_cache;
 use self::disk_cache::DiskCache;
@@ -182,6 +182,14 @@ fn render(
     template: &LlamaChatTemplate,
     messages: &[ChatMessage],
 ) -> Result<String, LlmError> {
+    // A final assistant message is the beginning of the answer: the turn is opened
+    // after the messages before it and that text follows, unclosed.
+    let (messages, prefill) = match messages.split_last() {
+        Some((last, rest)) if last.role == Role::Assistant && !rest.is_empty() => {
+            (rest, Some(last.content.as_str()))
+        }
+        _ => (messages, None),
+    };
     let chat = messages
         .iter()
         .enumerate()
@@ -193,14 +201,18 @@ fn render(
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    model
+    let mut prompt = model
         .apply_chat_template(template, &chat, true)
         .map_err(|e| LlmError::ChatTemplate {
             message: format!(
                 "llama.cpp cannot apply this chat template ({e}); it only knows the common \
                  families: set chat_template to one of its names, e.g. \"chatml\" or \"llama2\""
             ),
-        })
+        })?;
+    if let Some(p) = prefill {
+        prompt.push_str(p);
+    }
+    Ok(prompt)
 }
 
 /// Renders `messages` with `template` (a llama.cpp template name or template string) using

@@ -420,6 +420,36 @@ fn chat_templates_render() {
     let b = smol(512).unwrap();
     let p = b.render_prompt(&msgs).unwrap();
     assert!(p.ends_with("<|im_start|>assistant\n"), "{p:?}");
+
+    // A final assistant message begins the answer: the turn stays open after it.
+    let mut begun = msgs.to_vec();
+    begun.push(ChatMessage::assistant("objects: [(sofa"));
+    let q = b.render_prompt(&begun).unwrap();
+    assert_eq!(q, format!("{p}objects: [(sofa"));
+    let p = render_chat_template(&path, "chatml", &begun).unwrap();
+    assert!(
+        p.ends_with("<|im_start|>assistant\nobjects: [(sofa"),
+        "{p:?}"
+    );
+}
+
+#[test]
+fn a_begun_answer_is_continued_and_not_repeated() {
+    let _g = serial();
+    let Some(b) = smol(2048) else { return };
+    let mut req = ask("Answer with one word.", "Is the sky green?", 8);
+    req.grammar = Some(r#"root ::= [0-9] [0-9] "!""#.into());
+    let plain = b.complete(&req).unwrap();
+    req.messages.push(ChatMessage::assistant("answer: zebra-"));
+    // What follows the begun text; the grammar holds only the continuation.
+    let c = b.complete(&req).unwrap();
+    // The begun text is part of the prompt, not of the answer.
+    assert!(c.prompt_tokens > plain.prompt_tokens + 2, "{plain:?} {c:?}");
+    let t = c.text.as_bytes();
+    assert!(
+        c.text.len() == 3 && t[0].is_ascii_digit() && t[1].is_ascii_digit() && t[2] == b'!',
+        "{c:?}"
+    );
 }
 
 #[test]
