@@ -97,11 +97,6 @@ pub struct PlanOptions {
     /// With `said_only`, outside a conversation: a pick of each object may select only
     /// on the colours the person said that some object of that name has on this map.
     pub said_colours: bool,
-    /// Ask for the answer in two parts: the objects line, then the plan after it with
-    /// every pick held to a tuple of that line (its ordinal, colour and order; the other
-    /// keys free). Two requests, the second continuing the first's text (default off;
-    /// for comparison).
-    pub held_to_objects: bool,
 }
 
 impl Default for PlanOptions {
@@ -116,7 +111,6 @@ impl Default for PlanOptions {
             llguidance: true,
             said_only: true,
             said_colours: false,
-            held_to_objects: false,
         }
     }
 }

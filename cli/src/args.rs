@@ -247,10 +247,6 @@ pub(crate) struct ModelArgs {
     /// has on the map (outside a conversation; for comparison).
     #[arg(long, conflicts_with = "open_selections")]
     pub(crate) said_colours: bool,
-    /// Ask for the objects line first, then the plan with every pick held to a tuple of
-    /// that line (two requests; for comparison).
-    #[arg(long)]
-    pub(crate) held_to_objects: bool,
 }
 
 impl ModelArgs {
@@ -280,7 +276,6 @@ impl ModelArgs {
             answer_grammar: !self.no_grammar,
             said_only: !self.open_selections,
             said_colours: self.said_colours,
-            held_to_objects: self.held_to_objects,
             ..PlanOptions::default()
         }
     }

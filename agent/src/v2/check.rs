@@ -80,7 +80,7 @@ fn label_of(map: &IvlMap, name: &str, pose: Pose) -> Option<String> {
 /// The map label a word the person typed means, allowing a typo ("tabel", "chiar"): the
 /// exact reading first ([`label_of`]), else the one label or region within a small edit
 /// distance (1 for words up to 5 letters, 2 beyond), if exactly one is.
-pub(crate) fn label_of_typed(map: &IvlMap, name: &str, pose: Pose) -> Option<String> {
+fn label_of_typed(map: &IvlMap, name: &str, pose: Pose) -> Option<String> {
     if let Some(l) = label_of(map, name, pose) {
         return Some(l);
     }

@@ -31,8 +31,7 @@ use crate::tuples::{parse_tuples, Tuple};
 use self::answer::{objects_part, parse_answer, Answer};
 use self::check::{check_answer, runtime_finding, Finding, FindingKind};
 use self::grammar::{
-    answer_grammar, answer_lark, label_names, objects_grammar, objects_lark, objects_line_grammar,
-    objects_line_lark, plan_grammar, plan_lark, HeldPick, Vocabulary,
+    answer_grammar, answer_lark, label_names, objects_grammar, objects_lark, Vocabulary,
 };
 
 /// The messages of one request: system (+ scene), the nearest worked examples, the
@@ -245,107 +244,6 @@ fn colours_said_of(map: &map_core::IvlMap, instruction: &str) -> Vec<(Vec<String
     groups
 }
 
-/// The picks a plan may write under the objects line `tuples`: one per tuple that names
-/// an object on the map (regions and words the map lacks have none), its keys the
-/// tuple's ordinal, colour (the map's spelling; one the map lacks is left to the checks)
-/// and order. "The penultimate" as `(x, 2, None, far_to_near)` may also be written
-/// `ordinal: -2` (the same object counted nearest first).
-pub(crate) fn held_picks(
-    map: &map_core::IvlMap,
-    tuples: &[Tuple],
-    vocab: &Vocabulary,
-    pose: map_core::Pose,
-) -> Vec<HeldPick> {
-    let labels: Vec<String> = map.label_counts().into_iter().map(|(l, _)| l).collect();
-    let mut out = Vec::new();
-    for t in tuples {
-        let Some(label) = check::label_of_typed(map, &t.object, pose) else {
-            continue;
-        };
-        if !labels.contains(&label) {
-            continue;
-        }
-        let colour = t.colour.as_deref().and_then(|c| {
-            vocab
-                .colours
-                .iter()
-                .find(|m| map_core::matcher::canonical(m) == map_core::matcher::canonical(c))
-        });
-        let order = t
-            .order
-            .as_deref()
-            .and_then(|o| map_core::ObjectOrder::parse(o).ok())
-            .filter(|o| *o != map_core::ObjectOrder::NearToFar);
-        let keys = |ordinal: Option<i64>, order: Option<map_core::ObjectOrder>| {
-            let mut k = Vec::new();
-            if let Some(n) = ordinal {
-                k.push(format!("ordinal: {n}"));
-            }
-            if let Some(c) = colour {
-                k.push(format!("colour: \"{c}\""));
-            }
-            if let Some(o) = order {
-                k.push(format!("order: \"{}\"", o.name()));
-            }
-            k.join(", ")
-        };
-        let mut alts = vec![keys(t.ordinal, order)];
-        if let (Some(k), Some(map_core::ObjectOrder::FarToNear)) = (t.ordinal, order) {
-            alts.push(keys(Some(-k), None));
-        }
-        out.push(HeldPick {
-            names: label_names(label),
-            keys: alts,
-        });
-    }
-    out
-}
-
-/// The answer in two requests: the objects line alone, then the plan after it (the
-/// first part given back as the answer's beginning), each pick held to a tuple of that
-/// line ([`held_picks`]): the plan says what the model's own objects line says. An
-/// objects line that does not read leaves the picks free (the checks then find it).
-fn answer_in_two_parts(
-    backend: &dyn LlmBackend,
-    msgs: &[ChatMessage],
-    vocab: &Vocabulary,
-    ctx: &PlanContext<'_>,
-    timing: &mut Timing,
-) -> Result<String, LanguageError> {
-    let mut first = CompletionRequest::new(msgs.to_vec(), ctx.options.extract_max_tokens);
-    first.stop = vec!["\n".into()];
-    if ctx.options.answer_grammar {
-        first.grammar = Some(objects_line_grammar(vocab));
-        if ctx.options.llguidance {
-            first.lark = Some(objects_line_lark(vocab));
-        }
-    }
-    let c = backend.complete(&first)?;
-    timing.add(&c);
-    let line = c.text.trim_end();
-    let mut v = vocab.clone();
-    let tuples = objects_part(line).map_or(Some(line), |(_, t)| Some(t));
-    if let Some(Ok(tuples)) = tuples.map(parse_tuples) {
-        let held = held_picks(ctx.map, &tuples, vocab, ctx.pose());
-        if !held.is_empty() {
-            v.held = Some(held);
-        }
-    }
-    let begun = format!("{line}\nplan:\n");
-    let mut m = msgs.to_vec();
-    m.push(ChatMessage::assistant(begun.clone()));
-    let mut second = CompletionRequest::new(m, ctx.options.plan_max_tokens);
-    if ctx.options.answer_grammar {
-        second.grammar = Some(plan_grammar(&v));
-        if ctx.options.llguidance {
-            second.lark = Some(plan_lark(&v));
-        }
-    }
-    let c = backend.complete(&second)?;
-    timing.add(&c);
-    Ok(format!("{begun}{}", c.text))
-}
-
 /// Plans one instruction with one model call (and at most one re-ask).
 ///
 /// # Errors
@@ -381,18 +279,13 @@ pub fn plan_instruction(
     let mut findings = Vec::new();
     let last_round = u32::from(ctx.options.reask);
     for round in 0..=last_round {
-        let text = if ctx.options.held_to_objects {
-            answer_in_two_parts(backend, &msgs, &vocab, ctx, &mut timing)?
-        } else {
-            let mut req = CompletionRequest::new(msgs.clone(), ctx.options.plan_max_tokens);
-            req.grammar.clone_from(&grammar);
-            req.lark.clone_from(&lark);
-            let c = backend.complete(&req)?;
-            timing.add(&c);
-            c.text
-        };
-        attempts.push(text.clone());
-        match assess(&text, instruction, ctx) {
+        let mut req = CompletionRequest::new(msgs.clone(), ctx.options.plan_max_tokens);
+        req.grammar.clone_from(&grammar);
+        req.lark.clone_from(&lark);
+        let c = backend.complete(&req)?;
+        timing.add(&c);
+        attempts.push(c.text.clone());
+        match assess(&c.text, instruction, ctx) {
             Ok(a) => {
                 timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
                 return Ok(Outcome::Plan(Box::new(PlannedInstruction {
@@ -406,11 +299,11 @@ pub fn plan_instruction(
                 })));
             }
             Err(f) if round == last_round => {
-                tracing::debug!(round, answer = %text, findings = ?f, "answer still disagrees");
+                tracing::debug!(round, answer = %c.text, findings = ?f, "answer still disagrees");
                 findings = f;
             }
             Err(f) => {
-                tracing::debug!(round, answer = %text, findings = ?f, "answer disagrees; re-asking once");
+                tracing::debug!(round, answer = %c.text, findings = ?f, "answer disagrees; re-asking once");
                 // The re-ask is the same request with what the checks found added to it
                 // (measured: with the first answer left in the conversation, the model
                 // repeated it word for word under greedy decoding).
@@ -438,42 +331,6 @@ mod tests {
         let mut v = Vocabulary::for_map(&m);
         narrow_to_words(&mut v, instruction, &ctx);
         v
-    }
-
-    #[test]
-    fn each_tuple_of_an_object_on_the_map_holds_a_pick() {
-        let m = map();
-        let v = Vocabulary::for_map(&m);
-        let t = |o: &str, k: Option<i64>, c: Option<&str>, order: Option<&str>| Tuple {
-            order: order.map(str::to_string),
-            ..Tuple::new(o, k, c)
-        };
-        let tuples = [
-            // A typo names the chair; grey is the map's "grey".
-            t("chiar", Some(2), Some("gray"), Some("west_to_east")),
-            // A region and a word the map lacks hold nothing.
-            t("kitchen", None, None, None),
-            t("piano", None, None, None),
-            // The penultimate, counted either way.
-            t("cabinet", Some(2), None, Some("far_to_near")),
-            // A colour the map lacks is left to the checks.
-            t("couch", None, Some("purple"), None),
-        ];
-        let held = held_picks(&m, &tuples, &v, map_core::Pose::new(1.0, 1.0, 0.0));
-        assert_eq!(held.len(), 3, "{held:?}");
-        assert!(held[0].names.contains(&"chair".to_string()));
-        assert_eq!(
-            held[0].keys,
-            ["ordinal: 2, colour: \"grey\", order: \"west_to_east\""]
-        );
-        assert!(held[1].names.contains(&"cabinet".to_string()));
-        assert_eq!(
-            held[1].keys,
-            ["ordinal: 2, order: \"far_to_near\"", "ordinal: -2"]
-        );
-        assert!(held[2].names.contains(&"sofa".to_string()));
-        assert!(held[2].names.contains(&"couch".to_string()));
-        assert_eq!(held[2].keys, [""]);
     }
 
     #[test]
