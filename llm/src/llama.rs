@@ -430,9 +430,10 @@ fn worker_main(cfg: LlamaCppConfig, ready: SyncSender<Result<(), LlmError>>, rx:
         cfg: &cfg,
         llg: None,
         disk: if cfg.prefix_cache {
-            cfg.prompt_cache_dir
-                .as_deref()
-                .and_then(|d| DiskCache::open(d, &cfg.model_path))
+            cfg.prompt_cache_dir.as_deref().and_then(|d| {
+                let settings = format!("t{}-b{}", cfg.threads, cfg.n_batch);
+                DiskCache::open(d, &cfg.model_path, &settings)
+            })
         } else {
             None
         },

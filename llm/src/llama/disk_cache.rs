@@ -7,7 +7,12 @@
 //! sequence's keys and values, with its tokens) beside `<n>.tokens` (the same tokens as
 //! little-endian `i32`, read at start-up to choose an entry without loading it). The model
 //! key is the GGUF's file name, size and modification time, so a changed model never
-//! reads another's snapshot. An entry counts only when both files are there; a snapshot
+//! reads another's snapshot, followed by the evaluation's settings (threads, batch
+//! size): llama.cpp's sums run in another order with another thread count, and measured
+//! (Qwen 1.5B, a people.nav instruction) a prefix evaluated on 1 thread and read back by
+//! a 2-thread run changed a greedy answer (`#{colour: "black"}` where 2 threads from
+//! scratch write `#{ordinal: 1, colour: "black"}`), so a snapshot is read back only
+//! under the settings that wrote it. An entry counts only when both files are there; a snapshot
 //! llama.cpp refuses to load (another llama.cpp version, a truncated file) is deleted.
 //!
 //! What is saved: when a request reuses at least [`MIN_TOKENS`] tokens of a slot (the
@@ -49,8 +54,9 @@ pub struct DiskCache {
     entries: Vec<Entry>,
 }
 
-/// The folder name for a model: its file name, size and modification time.
-fn model_key(model: &Path) -> Option<String> {
+/// The folder name for a model evaluated under `settings`: its file name, size and
+/// modification time, then the settings.
+fn model_key(model: &Path, settings: &str) -> Option<String> {
     let meta = fs::metadata(model).ok()?;
     let mtime = meta
         .modified()
@@ -69,7 +75,11 @@ fn model_key(model: &Path) -> Option<String> {
             }
         })
         .collect();
-    Some(format!("{name}-{}-{mtime}", meta.len()))
+    let settings: String = settings
+        .chars()
+        .filter(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_'))
+        .collect();
+    Some(format!("{name}-{}-{mtime}-{settings}", meta.len()))
 }
 
 /// Length of the common prefix of two token lists.
@@ -92,12 +102,13 @@ fn read_tokens(path: &Path) -> Option<Vec<LlamaToken>> {
 }
 
 impl DiskCache {
-    /// Opens (creating it) the folder for `model` under `root` and reads its entries'
-    /// token lists. `None` when the folder cannot be made or the model cannot be read:
-    /// the cache is an optimisation, never a reason to fail.
+    /// Opens (creating it) the folder for `model` evaluated under `settings` (what
+    /// changes the numbers a prefix evaluates to, e.g. `t2-b512`) under `root` and reads
+    /// its entries' token lists. `None` when the folder cannot be made or the model
+    /// cannot be read: the cache is an optimisation, never a reason to fail.
     #[must_use]
-    pub fn open(root: &Path, model: &Path) -> Option<Self> {
-        let dir = root.join(model_key(model)?);
+    pub fn open(root: &Path, model: &Path, settings: &str) -> Option<Self> {
+        let dir = root.join(model_key(model, settings)?);
         if let Err(e) = fs::create_dir_all(&dir) {
             tracing::warn!(dir = %dir.display(), error = %e, "prompt cache off: cannot create its folder");
             return None;
@@ -224,7 +235,7 @@ mod tests {
         let root = tempdir("reopen");
         let model = root.join("m.gguf");
         fs::write(&model, b"not really a model").unwrap();
-        let mut c = DiskCache::open(&root, &model).unwrap();
+        let mut c = DiskCache::open(&root, &model, "t2-b512").unwrap();
         assert!(c.is_empty());
         let a = toks(0..600);
         let b = toks((0..550).chain(1000..1100));
@@ -233,7 +244,7 @@ mod tests {
             fs::write(&kv, b"snapshot").unwrap();
             c.add(kv, t);
         }
-        let c = DiskCache::open(&root, &model).unwrap();
+        let c = DiskCache::open(&root, &model, "t2-b512").unwrap();
         assert_eq!(c.len(), 2);
         let prompt = toks((0..550).chain(1000..1050).chain(7..9));
         let (e, n) = c.best(&prompt).unwrap();
@@ -254,7 +265,7 @@ mod tests {
         let root = tempdir("evict");
         let model = root.join("m.gguf");
         fs::write(&model, b"x").unwrap();
-        let mut c = DiskCache::open(&root, &model).unwrap();
+        let mut c = DiskCache::open(&root, &model, "t2-b512").unwrap();
         let mut first = None;
         for k in 0..(MAX_ENTRIES as i32 + 2) {
             let kv = c.next_path();
@@ -276,16 +287,21 @@ mod tests {
         let root = tempdir("key");
         let model = root.join("m.gguf");
         fs::write(&model, b"one").unwrap();
-        let mut c = DiskCache::open(&root, &model).unwrap();
+        let mut c = DiskCache::open(&root, &model, "t2-b512").unwrap();
         let kv = c.next_path();
         fs::write(&kv, b"s").unwrap();
         c.add(kv.clone(), &toks(0..600));
         fs::write(kv.with_extension("tokens"), [1u8, 2, 3]).unwrap();
-        assert!(DiskCache::open(&root, &model).unwrap().is_empty());
+        assert!(DiskCache::open(&root, &model, "t2-b512")
+            .unwrap()
+            .is_empty());
         fs::write(&model, b"a longer model").unwrap();
-        let other = DiskCache::open(&root, &model).unwrap();
+        let other = DiskCache::open(&root, &model, "t2-b512").unwrap();
         assert!(other.is_empty());
         assert_ne!(other.dir, c.dir);
+        // Another thread count or batch size: another folder.
+        let t1 = DiskCache::open(&root, &model, "t1-b512").unwrap();
+        assert_ne!(t1.dir, other.dir);
         let _ = fs::remove_dir_all(&root);
     }
 }
