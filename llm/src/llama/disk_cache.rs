@@ -12,8 +12,9 @@
 //! (Qwen 1.5B, a people.nav instruction) a prefix evaluated on 1 thread and read back by
 //! a 2-thread run changed a greedy answer (`#{colour: "black"}` where 2 threads from
 //! scratch write `#{ordinal: 1, colour: "black"}`), so a snapshot is read back only
-//! under the settings that wrote it. An entry counts only when both files are there; a snapshot
-//! llama.cpp refuses to load (another llama.cpp version, a truncated file) is deleted.
+//! under the settings that wrote it. An entry counts only when both files are there; a
+//! snapshot llama.cpp refuses to load (another llama.cpp version, a truncated file) is
+//! deleted.
 //!
 //! What is saved: when a request reuses at least [`MIN_TOKENS`] tokens of a slot (the
 //! prefix two requests shared) and no entry already covers that prefix, the slot's
@@ -63,10 +64,14 @@ fn model_key(model: &Path, settings: &str) -> Option<String> {
         .ok()
         .and_then(|t| t.duration_since(UNIX_EPOCH).ok())
         .map_or(0, |d| d.as_secs());
-    let name: String = model
-        .file_name()?
-        .to_string_lossy()
-        .chars()
+    let name = folder_safe(&model.file_name()?.to_string_lossy());
+    let settings = folder_safe(settings);
+    Some(format!("{name}-{}-{mtime}-{settings}", meta.len()))
+}
+
+/// `s` with every character but ASCII letters, digits, `.`, `-` and `_` made `_`.
+fn folder_safe(s: &str) -> String {
+    s.chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_') {
                 c
@@ -74,12 +79,7 @@ fn model_key(model: &Path, settings: &str) -> Option<String> {
                 '_'
             }
         })
-        .collect();
-    let settings: String = settings
-        .chars()
-        .filter(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_'))
-        .collect();
-    Some(format!("{name}-{}-{mtime}-{settings}", meta.len()))
+        .collect()
 }
 
 /// Length of the common prefix of two token lists.
