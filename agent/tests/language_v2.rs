@@ -200,6 +200,12 @@ fn no_rule_changes_a_typed_answer() {
             "go to the red sofa and come back here",
             "objects: [(sofa, None, red)]\nplan:\nlet s = get_obj(\"sofa\", #{colour: \"red\"});\nmove_to_left(s);\nmove_to_start();\n",
         ),
+        // The comment lines quoting the person's words (the worked examples' form) are
+        // not part of the plan.
+        (
+            "go to the black sofa and then come back here",
+            "objects: [(sofa, None, black)]\nplan:\n// the black sofa\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\n// come back here\nmove_to_start();\n",
+        ),
     ];
     for (instruction, answer) in cases {
         let b = Scripted::new(&[answer]);
@@ -325,4 +331,34 @@ fn with_all_examples_everything_before_the_request_is_the_same_for_every_map() {
     );
     assert!(rb.starts_with("The map here: ") && ra != rb, "{rb}");
     assert!(!a[0].content.contains("The map here"), "{}", a[0].content);
+}
+
+#[test]
+fn a_prompt_set_that_quotes_the_words_gets_a_grammar_that_lets_the_model_quote_them() {
+    // prompts/variants/quoted: each call of a worked example follows a comment line with
+    // the person's words; the grammar follows the prompt's answer form, the default set's
+    // does not offer comments.
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let variant = concat!(env!("CARGO_MANIFEST_DIR"), "/../prompts/variants/quoted");
+    let answer = "objects: [(sofa, None, black)]\nplan:\n// the black sofa\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));";
+    for (prompts, quoted) in [
+        (Prompts::load(variant).unwrap(), true),
+        (Prompts::builtin(), false),
+    ] {
+        let b = Scripted::new(&[answer]);
+        let out =
+            plan_instruction(&b, &prompts, "go to the black sofa", &v2(&map, &robot)).unwrap();
+        assert!(out.plan().is_some(), "{out:?}");
+        let req = &b.requests()[0];
+        let lark = req.lark.as_deref().unwrap();
+        let gbnf = req.grammar.as_deref().unwrap();
+        assert_eq!(lark.contains("comment:"), quoted, "{lark}");
+        assert_eq!(gbnf.contains("comment ::="), quoted, "{gbnf}");
+        assert_eq!(
+            req.messages[2].content.contains("\n// "),
+            quoted,
+            "the first worked example's answer"
+        );
+    }
 }

@@ -116,6 +116,35 @@ fn selections_nest_and_print_canonically() {
 }
 
 #[test]
+fn comment_lines_are_not_steps_and_keep_positions() {
+    // The language layer's answers quote the person's words in a comment above each call.
+    let plain = "move_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to_start();";
+    let commented = "// the red sofa\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\n\
+                     // and \"come back\" here\nmove_to_start();";
+    assert_eq!(
+        TypedPlan::parse(commented).unwrap(),
+        TypedPlan::parse(plain).unwrap()
+    );
+    assert!(!TypedPlan::parse(commented)
+        .unwrap()
+        .to_rhai()
+        .contains("//"));
+    // Positions count the comment lines.
+    let e = TypedPlan::parse("// first\nturn(90);\n// the loop\nfor i in 0..3 { turn(90); }")
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            TypedError::NotStraightLine {
+                span: Span { line: 4, col: 1 },
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+#[test]
 fn what_is_not_straight_line_is_refused_with_its_position() {
     let e = TypedPlan::parse("agent.move_to_object(\"sofa\");\nfor i in 0..3 { turn(90); }")
         .unwrap_err();

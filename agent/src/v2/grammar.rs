@@ -34,6 +34,10 @@ pub struct Vocabulary {
     /// groups of names sharing one colour list (`None`: every name any of `colours`).
     /// A group with no colours picks that name without a colour key.
     pub colours_of: Option<Vec<(Vec<String>, Vec<String>)>>,
+    /// Let each statement follow a comment line (`// ` and up to 120 characters), for a
+    /// prompt set whose worked examples quote the person's words above each call
+    /// (`prompts/variants/quoted`). Off: the plan is calls only.
+    pub comments: bool,
 }
 
 /// The names a label goes by in a plan: its synonyms, then the label (blank ones left out).
@@ -71,6 +75,7 @@ impl Vocabulary {
             ordinals: None,
             no_directions: false,
             colours_of: None,
+            comments: false,
         }
     }
 }
@@ -317,7 +322,16 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
     w.rule("root", "objects \"\\nplan:\\n\" stmt (\"\\n\" stmt){0,15}");
     objects_rules(&mut w, &vocab.colours);
     let steps: Vec<String> = STEP_FUNCTIONS.iter().filter_map(|n| call_rule(n)).collect();
-    w.rule("stmt", "letstmt | step");
+    if vocab.comments {
+        // Each statement may follow a comment line quoting the person's words it carries
+        // out (as the worked examples of such a prompt set do). Comments do not reach the
+        // plan: Rhai drops them, the typed plan has none.
+        w.rule("stmt", "(comment \"\\n\")? (letstmt | step)");
+        let text = w.pattern("[^\\n]{1,120}", "[^\\n]{1,120}");
+        w.rule("comment", &format!("\"// \" {text}"));
+    } else {
+        w.rule("stmt", "letstmt | step");
+    }
     w.rule("letstmt", "\"let \" var \" = \" pick \";\"");
     w.rule("step", &format!("({}) \";\"", steps.join(" | ")));
     let var = w.pattern("[a-z] [a-z0-9_]{0,15}", "[a-z][a-z0-9_]{0,15}");
@@ -497,6 +511,90 @@ mod tests {
         }
         // The test sees a missing rule.
         assert_eq!(undefined_rules("root ::= \"a\" b [c-d]"), ["b"]);
+    }
+
+    /// Whether the Lark grammar accepts `text` in full (llguidance's matcher, one byte per
+    /// token).
+    fn lark_accepts(lark: &str, text: &str) -> Result<(), String> {
+        let env = llguidance::toktrie::ApproximateTokEnv::single_byte_env();
+        let factory = llguidance::ParserFactory::new_simple(&env).map_err(|e| e.to_string())?;
+        let grammar = llguidance::api::TopLevelGrammar::from_lark(lark.to_string());
+        let parser = factory.create_parser(grammar).map_err(|e| e.to_string())?;
+        let mut m = llguidance::Matcher::new(Ok(parser));
+        for (i, b) in text.bytes().enumerate() {
+            m.consume_token(u32::from(b))
+                .map_err(|e| format!("rejected at byte {i} ({:?}): {e}", &text[..=i]))?;
+        }
+        if m.is_accepting().map_err(|e| e.to_string())? {
+            Ok(())
+        } else {
+            Err("the grammar wants more".into())
+        }
+    }
+
+    /// The vocabulary of the worked examples themselves (their names, colours and rooms,
+    /// what a map would supply, and the ids their conversations visited).
+    fn examples_vocabulary(examples: &[crate::v2::examples::WorkedExample]) -> Vocabulary {
+        let mut v = Vocabulary::default();
+        for e in examples {
+            for line in e.answer.lines().filter(|l| !l.starts_with("//")) {
+                for (i, part) in line.split('"').enumerate() {
+                    if i % 2 == 1 {
+                        v.names.push(part.to_string());
+                        v.colours.push(part.to_string());
+                        v.regions.push(part.to_string());
+                    }
+                }
+            }
+            for part in e.answer.split("get_instance(").skip(1) {
+                let id: String = part.chars().take_while(char::is_ascii_digit).collect();
+                v.ids.push(id.parse().unwrap());
+            }
+        }
+        for list in [&mut v.names, &mut v.colours, &mut v.regions] {
+            list.sort();
+            list.dedup();
+        }
+        v.ids.sort_unstable();
+        v.ids.dedup();
+        v
+    }
+
+    #[test]
+    fn every_worked_example_is_an_answer_the_grammar_accepts() {
+        let variant = concat!(env!("CARGO_MANIFEST_DIR"), "/../prompts/variants/quoted");
+        for (prompts, quoted) in [
+            (crate::Prompts::builtin(), false),
+            (crate::Prompts::load(variant).unwrap(), true),
+        ] {
+            let (text, origin) = prompts.worked_examples();
+            let examples = crate::v2::examples::parse_examples(text, origin).unwrap();
+            assert_eq!(crate::v2::quotes_words(&examples), quoted, "{origin}");
+            let mut v = examples_vocabulary(&examples);
+            v.comments = quoted;
+            let lark = answer_lark(&v);
+            let mut commented = 0;
+            for e in &examples {
+                let answer = e.answer.trim_end();
+                commented += usize::from(answer.contains("\n// "));
+                if let Err(why) = lark_accepts(&lark, answer) {
+                    panic!("{origin}, line {}: {why}\n{answer}", e.line);
+                }
+            }
+            let plain = "objects: [(chair, 3, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 3}));";
+            let quoting = "objects: [(chair, 3, None)]\nplan:\n// the third chair\nmove_to_object(get_obj(\"chair\", #{ordinal: 3}));";
+            lark_accepts(&lark, plain).unwrap();
+            if quoted {
+                // Every example quotes the person's words; a plan without them is still
+                // an answer, a comment with no call after it is not.
+                assert_eq!(commented, examples.len());
+                lark_accepts(&lark, quoting).unwrap();
+                assert!(lark_accepts(&lark, "objects: []\nplan:\n// turn").is_err());
+            } else {
+                assert_eq!(commented, 0);
+                assert!(lark_accepts(&lark, quoting).is_err());
+            }
+        }
     }
 
     #[test]

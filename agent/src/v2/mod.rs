@@ -99,6 +99,16 @@ pub fn extract(
     Ok((tuples, timing))
 }
 
+/// Whether the worked examples quote the person's words in a comment line above the calls
+/// (the answer form of `prompts/variants/quoted`): the grammar then lets the model do so
+/// too.
+#[must_use]
+pub fn quotes_words(examples: &[examples::WorkedExample]) -> bool {
+    examples
+        .iter()
+        .any(|e| e.answer.lines().any(|l| l.trim_start().starts_with("// ")))
+}
+
 /// An answer that read and passed every check, compiled.
 struct Accepted {
     answer: Answer,
@@ -267,6 +277,7 @@ pub fn plan_instruction(
     let vocab = {
         let mut v = Vocabulary::for_map(ctx.map);
         v.ids.clone_from(&ctx.references);
+        v.comments = quotes_words(prompts.example_index()?.examples());
         if ctx.options.said_only {
             narrow_to_words(&mut v, instruction, ctx);
         }
