@@ -99,3 +99,29 @@ fn broken_variants_fail_at_load_with_file_and_line() {
         Err(PromptError::Io { .. })
     ));
 }
+
+#[test]
+fn the_quoted_variant_is_the_default_examples_with_the_words_quoted() {
+    // prompts/variants/quoted copies the default worked examples and adds a comment line
+    // above each call: the copies must not drift apart, or comparing the two measures
+    // more than the answer form.
+    let examples = |p: &Prompts| {
+        let (text, origin) = p.worked_examples();
+        agent::v2::examples::parse_examples(text, origin).unwrap()
+    };
+    let default = examples(&Prompts::builtin());
+    let quoted = examples(&Prompts::load(repo_prompts().join("variants/quoted")).unwrap());
+    assert_eq!(default.len(), quoted.len());
+    for (d, q) in default.iter().zip(&quoted) {
+        assert_eq!(d.instruction, q.instruction, "line {}", q.line);
+        assert_eq!(d.history, q.history, "line {}", q.line);
+        let unquoted: Vec<&str> = q.answer.lines().filter(|l| !l.starts_with("// ")).collect();
+        let plain: Vec<&str> = d.answer.lines().collect();
+        assert_eq!(plain, unquoted, "line {}", q.line);
+        assert!(
+            q.answer.lines().any(|l| l.starts_with("// ")),
+            "line {}",
+            q.line
+        );
+    }
+}
