@@ -81,6 +81,15 @@ impl ObjectOrder {
         )
     }
 
+    /// Whether the order counts by size ("the biggest", "the second smallest").
+    #[must_use]
+    pub fn is_by_size(self) -> bool {
+        matches!(
+            self,
+            ObjectOrder::LargestToSmallest | ObjectOrder::SmallestToLargest
+        )
+    }
+
     /// The same ranking counted from the other end ("the second to last from the
     /// west" is the 2nd in `east_to_west`).
     #[must_use]
@@ -390,6 +399,17 @@ impl IvlMap {
 mod tests {
     use super::*;
     use crate::scene::Scene;
+
+    #[test]
+    fn orders_by_direction_and_by_size() {
+        for (o, name) in ObjectOrder::ALL {
+            let by_size = matches!(name, "largest_to_smallest" | "smallest_to_largest");
+            let by_distance = matches!(name, "near_to_far" | "far_to_near");
+            assert_eq!(o.is_by_size(), by_size, "{name}");
+            assert_eq!(o.is_directional(), !by_size && !by_distance, "{name}");
+            assert_eq!(o.reversed().is_by_size(), by_size, "{name}");
+        }
+    }
 
     /// Robot at the origin facing north. Tables at x = 1..4 along y = 3, the
     /// yellow ones at x = 1 and 3.

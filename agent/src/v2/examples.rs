@@ -276,8 +276,12 @@ mod tests {
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let unsaid = super::super::check::unsaid_directions(&e.instruction, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
+            let unsaid = super::super::check::unsaid_sizes(&e.instruction, &a.plan);
+            assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let in_chat = e.history.is_some();
             let unsaid = super::super::check::unsaid_ordinals(&e.instruction, in_chat, &a.plan);
+            assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
+            let unsaid = super::super::check::unsaid_regions(&e.instruction, in_chat, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             planner_dsl::Plan::compile(&a.plan.to_rhai())
                 .unwrap_or_else(|err| panic!("example at line {}: {err}", e.line));

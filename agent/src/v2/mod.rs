@@ -196,8 +196,9 @@ fn settle(findings: &[Finding]) -> Outcome {
 }
 
 /// Narrows `v` to what the person said ([`PlanOptions::said_only`](crate::PlanOptions)):
-/// the counts the instruction says (outside a conversation), directional orders only
-/// when it names a direction. The same tests as the checks' ([`check::counts_said`],
+/// the counts the instruction says and the regions it names for the `region` key
+/// (outside a conversation), directional orders only when it names a direction, orders
+/// by size only when it speaks of size. The same tests as the checks' ([`check::counts_said`],
 /// [`check::direction_said`]), so the grammar never offers what those checks would
 /// re-ask.
 ///
@@ -219,8 +220,11 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
         if ctx.options.said_colours {
             v.colours_of = Some(colours_said_of(ctx.map, instruction));
         }
+        let said = check::region_said(instruction);
+        v.region_keys = Some(v.regions.iter().filter(|r| said(r)).cloned().collect());
     }
     v.no_directions = !check::direction_said(instruction);
+    v.no_sizes = !check::size_said(instruction);
 }
 
 /// Per object name, the colours the person said that some object of that name has on
@@ -345,14 +349,14 @@ mod tests {
     }
 
     #[test]
-    fn the_grammar_offers_only_the_counts_and_directions_the_person_said() {
+    fn the_grammar_offers_only_the_counts_directions_and_regions_the_person_said() {
         let v = narrowed("go to the thrid red chair, then the black sofa", &[]);
         let ks = v.ordinals.clone().unwrap();
         for k in [1, -1, 3, -3] {
             assert!(ks.contains(&k), "{ks:?}");
         }
         assert!(!ks.contains(&2) && !ks.contains(&-2), "{ks:?}");
-        assert!(v.no_directions);
+        assert!(v.no_directions && v.no_sizes);
         // Colours stay the map's (the checks judge them).
         assert_eq!(v.colours, Vocabulary::for_map(&map()).colours);
         for g in [answer_lark(&v), answer_grammar(&v)] {
@@ -367,15 +371,33 @@ mod tests {
             };
             let (qorder, int) = (rule("qorder"), rule("int"));
             assert!(
-                qorder.contains("far_to_near") && !qorder.contains("west_to_east"),
+                qorder.contains("far_to_near")
+                    && !qorder.contains("west_to_east")
+                    && !qorder.contains("largest_to_smallest"),
                 "{g}"
             );
             assert!(int.contains("\"-3\"") && !int.contains("\"2\""), "{g}");
         }
 
+        // No room named: no region key; a room named: that room only (a bare room name
+        // stays any of the map's).
+        assert_eq!(v.region_keys.as_deref(), Some(&[][..]));
+        let g = answer_lark(&v);
+        assert!(!g.contains("region: "), "{g}");
+        assert!(g.contains("\"\\\"office\\\"\""), "a bare room name: {g}");
+        let v = narrowed("the plant in the kitchn, then the sofa", &[]);
+        assert_eq!(v.region_keys, Some(vec!["kitchen".to_string()]));
+        let g = answer_grammar(&v);
+        let qregion = g.lines().find(|l| l.starts_with("qregion ::=")).unwrap();
+        assert!(
+            qregion.contains("kitchen") && !qregion.contains("office"),
+            "{g}"
+        );
+
         // A direction and "penultimate".
         let v = narrowed("counting from the west, the penultimate chair", &[]);
-        assert!(!v.no_directions);
+        assert!(!v.no_directions && v.no_sizes);
+        assert!(!narrowed("the second biggest table", &[]).no_sizes);
         let ks = v.ordinals.unwrap();
         assert!(ks.contains(&-2) && !ks.contains(&2), "{ks:?}");
     }
