@@ -687,40 +687,6 @@ pub(crate) fn unsaid_regions<'a>(
         .collect()
 }
 
-/// [`unsaid_regions`] as findings: the re-ask asks to leave the region out.
-fn check_unsaid_regions(
-    map: &IvlMap,
-    instruction: &str,
-    in_chat: bool,
-    plan: &TypedPlan,
-    pose: Pose,
-) -> Vec<Finding> {
-    let mut out: Vec<Finding> = Vec::new();
-    for t in unsaid_regions(instruction, in_chat, plan) {
-        let region = t.region.as_deref().unwrap_or_default();
-        let to_user = match label_of(map, &t.name, pose) {
-            Some(l) => format!(
-                "which {} do you mean? there are {}",
-                t.name,
-                describe_label(map, &l)
-            ),
-            None => format!("which {} do you mean?", t.name),
-        };
-        let f = Finding::new(
-            FindingKind::Word,
-            format!(
-                "the plan picks the {} in the {region}, but the person did not name the {region}: leave the region out unless their words put it in a room",
-                t.name
-            ),
-            to_user,
-        );
-        if !out.contains(&f) {
-            out.push(f);
-        }
-    }
-    out
-}
-
 /// Whether a word of `instruction` speaks of size ("the biggest", "the small table",
 /// "largest"), which an order by size needs.
 pub(crate) fn size_said(instruction: &str) -> bool {
@@ -741,26 +707,6 @@ pub(crate) fn unsaid_sizes<'a>(instruction: &str, plan: &'a TypedPlan) -> Vec<&'
         .into_iter()
         .filter(|t| t.order.is_by_size())
         .collect()
-}
-
-/// [`unsaid_sizes`] as findings: the re-ask asks for the default order.
-fn check_unsaid_sizes(instruction: &str, plan: &TypedPlan) -> Vec<Finding> {
-    let mut out: Vec<Finding> = Vec::new();
-    for t in unsaid_sizes(instruction, plan) {
-        let f = Finding::new(
-            FindingKind::Word,
-            format!(
-                "the plan counts the {} in order \"{}\", but the person said nothing of size: leave the order out (nearest first) unless their words give one",
-                t.name,
-                t.order.name()
-            ),
-            format!("which {} do you mean?", t.name),
-        );
-        if !out.contains(&f) {
-            out.push(f);
-        }
-    }
-    out
 }
 
 /// Whether a word of `instruction` names a side or a compass direction, which a
@@ -896,52 +842,26 @@ pub(crate) fn unsaid_ordinals<'a>(
         .collect()
 }
 
-/// [`unsaid_ordinals`] as findings: the re-ask asks to leave the count out.
-fn check_unsaid_ordinals(
+/// What a finding tells the model about a target.
+type Note = dyn Fn(&Target) -> String;
+
+/// Findings for targets that select on something the person did not say, one per
+/// distinct message: `to_model` says what to leave out, the question names the object's
+/// candidates where `map` holds it.
+fn unsaid_findings(
     map: &IvlMap,
-    instruction: &str,
-    in_chat: bool,
-    plan: &TypedPlan,
     pose: Pose,
+    targets: Vec<&Target>,
+    to_model: impl Fn(&Target) -> String,
+    to_user: impl Fn(&Target) -> String,
 ) -> Vec<Finding> {
     let mut out: Vec<Finding> = Vec::new();
-    for t in unsaid_ordinals(instruction, in_chat, plan) {
-        let to_user = match label_of(map, &t.name, pose) {
-            Some(l) => format!(
-                "which {} do you mean? there are {}",
-                t.name,
-                describe_label(map, &l)
-            ),
-            None => format!("which {} do you mean?", t.name),
+    for t in targets {
+        let question = match label_of(map, &t.name, pose) {
+            Some(l) => format!("{}? there are {}", to_user(t), describe_label(map, &l)),
+            None => format!("{}?", to_user(t)),
         };
-        let f = Finding::new(
-            FindingKind::Word,
-            format!(
-                "the plan picks the {} with ordinal {}, but the person said no such count: leave the ordinal out unless their words count (\"the third\", \"number 3\", \"second to last\")",
-                t.name, t.ordinal
-            ),
-            to_user,
-        );
-        if !out.contains(&f) {
-            out.push(f);
-        }
-    }
-    out
-}
-
-/// [`unsaid_directions`] as findings: the re-ask asks for the default order.
-fn check_unsaid_directions(instruction: &str, plan: &TypedPlan) -> Vec<Finding> {
-    let mut out: Vec<Finding> = Vec::new();
-    for t in unsaid_directions(instruction, plan) {
-        let f = Finding::new(
-            FindingKind::Word,
-            format!(
-                "the plan counts the {} in order \"{}\", but the person named no direction: leave the order out (nearest first) unless their words give one",
-                t.name,
-                t.order.name()
-            ),
-            format!("which {} do you mean, counting from where?", t.name),
-        );
+        let f = Finding::new(FindingKind::Word, to_model(t), question);
         if !out.contains(&f) {
             out.push(f);
         }
@@ -973,22 +893,37 @@ pub fn check_answer(
         .filter_map(|i| i.colour.clone())
         .collect();
     out.extend(check_unsaid_colours(map, instruction, &known, plan, pose));
-    out.extend(check_unsaid_directions(instruction, plan));
-    out.extend(check_unsaid_sizes(instruction, plan));
-    out.extend(check_unsaid_regions(
-        map,
-        instruction,
-        !refs.is_empty(),
-        plan,
-        pose,
-    ));
-    out.extend(check_unsaid_ordinals(
-        map,
-        instruction,
-        !refs.is_empty(),
-        plan,
-        pose,
-    ));
+    let in_chat = !refs.is_empty();
+    // What a selection may say only when the person's words do: each with the re-ask's
+    // note and the question's words after "which <name> do you mean".
+    let directions = |t: &Target| {
+        format!("the plan counts the {} in order \"{}\", but the person named no direction: leave the order out (nearest first) unless their words give one", t.name, t.order.name())
+    };
+    let sizes = |t: &Target| {
+        format!("the plan counts the {} in order \"{}\", but the person said nothing of size: leave the order out (nearest first) unless their words give one", t.name, t.order.name())
+    };
+    let regions = |t: &Target| {
+        let region = t.region.as_deref().unwrap_or_default();
+        format!("the plan picks the {} in the {region}, but the person did not name the {region}: leave the region out unless their words put it in a room", t.name)
+    };
+    let ordinals = |t: &Target| {
+        format!("the plan picks the {} with ordinal {}, but the person said no such count: leave the ordinal out unless their words count (\"the third\", \"number 3\", \"second to last\")", t.name, t.ordinal)
+    };
+    let unsaid: [(Vec<&Target>, &Note, &str); 4] = [
+        (
+            unsaid_directions(instruction, plan),
+            &directions,
+            ", counting from where",
+        ),
+        (unsaid_sizes(instruction, plan), &sizes, ""),
+        (unsaid_regions(instruction, in_chat, plan), &regions, ""),
+        (unsaid_ordinals(instruction, in_chat, plan), &ordinals, ""),
+    ];
+    for (targets, to_model, how) in unsaid {
+        out.extend(unsaid_findings(map, pose, targets, to_model, |t| {
+            format!("which {} do you mean{how}", t.name)
+        }));
+    }
     // A plan with no step that moves or turns does nothing the person asked for.
     if !plan
         .steps
