@@ -437,8 +437,15 @@ async fn record(model: PathBuf) -> Option<Recorded> {
     std::fs::create_dir_all(&dir).unwrap();
     let cassette = dir.join("smollm2-serve.jsonl");
     let _ = std::fs::remove_file(&cassette);
+    // Every request evaluated from scratch: with the prefix kept, SmolLM2's greedy answer
+    // to the same request differed between the first request (prompt evaluated whole) and
+    // a later one (prefix reused), so the cassette held one request with two answers, and
+    // a replay in another order gave a session the other one (seen in CI, 2026-11-26).
+    let mut cfg = LlamaCppConfig::new(model);
+    cfg.n_ctx = 8192;
+    cfg.prefix_cache = false;
     let backend: Arc<dyn LlmBackend> =
-        Arc::new(Recording::new(smol_backend(model), cassette.clone()).unwrap());
+        Arc::new(Recording::new(LlamaCppBackend::new(cfg).unwrap(), cassette.clone()).unwrap());
     let running = start(
         Service::new(flat_a(), backend),
         ServeConfig {
