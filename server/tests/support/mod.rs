@@ -87,6 +87,18 @@ pub async fn start(service: Service, config: ServeConfig) -> Running {
     }
 }
 
+/// A server on flat-a answering with `backend` on one worker.
+pub async fn one_worker(backend: Arc<dyn LlmBackend>) -> Running {
+    start(
+        Service::new(flat_a(), backend),
+        ServeConfig {
+            workers: 1,
+            ..local()
+        },
+    )
+    .await
+}
+
 /// A JSON client for the API.
 #[derive(Clone)]
 pub struct Api {
@@ -443,14 +455,7 @@ async fn record(model: PathBuf) -> Option<Recorded> {
     cfg.n_ctx = 8192;
     let backend: Arc<dyn LlmBackend> =
         Arc::new(Recording::new(LlamaCppBackend::new(cfg).unwrap(), cassette.clone()).unwrap());
-    let running = start(
-        Service::new(flat_a(), backend),
-        ServeConfig {
-            workers: 1,
-            ..local()
-        },
-    )
-    .await;
+    let running = one_worker(backend).await;
     let api = running.api();
     // One listener sees the queue at work.
     let watch_id = api.session().await;
@@ -549,14 +554,7 @@ fn one_answer_per_request(path: &std::path::Path) -> PathBuf {
 /// worker: what every session saying that sequence must be answered, whatever the load.
 async fn replay_in_turn(cassette: &std::path::Path) -> Vec<Replies> {
     let backend: Arc<dyn LlmBackend> = Arc::new(ReplayBackend::open(cassette).unwrap());
-    let running = start(
-        Service::new(flat_a(), backend),
-        ServeConfig {
-            workers: 1,
-            ..local()
-        },
-    )
-    .await;
+    let running = one_worker(backend).await;
     let api = running.api();
     let mut all = Vec::new();
     for seq in SEQUENCES {
