@@ -635,12 +635,16 @@ pub(crate) fn colour_said<'a>(
         .filter_map(|w| normalise_colour(w))
         .map(|c| canonical(&c))
         .collect();
-    let close = move |c: &str| {
-        let limit = if c.chars().count() <= 5 { 1 } else { 2 };
-        said.iter()
-            .any(|w| w == c || strsim::damerau_levenshtein(w, c) <= limit)
-    };
+    let close = move |c: &str| typed_as(&said, c, 6);
     move |c: &str| close(&canonical(c)) || words(c).iter().any(|w| close(&canonical(w)))
+}
+
+/// Whether one of the `said` words is `word` or a typo of it: one edit from it, two for
+/// a `word` of `long` letters or more.
+fn typed_as(said: &[String], word: &str, long: usize) -> bool {
+    let limit = if word.chars().count() < long { 1 } else { 2 };
+    said.iter()
+        .any(|s| s == word || strsim::damerau_levenshtein(s, word) <= limit)
 }
 
 /// Whether a region (a room) is named by `instruction`: every word of the region's name,
@@ -650,11 +654,7 @@ pub(crate) fn colour_said<'a>(
 pub(crate) fn region_said(instruction: &str) -> impl Fn(&str) -> bool {
     let said = words(instruction);
     move |region: &str| {
-        let close = |w: &str| {
-            let limit = if w.chars().count() < 8 { 1 } else { 2 };
-            said.iter()
-                .any(|s| s == w || strsim::damerau_levenshtein(s, w) <= limit)
-        };
+        let close = |w: &str| typed_as(&said, w, 8);
         let mut names: Vec<String> = map_core::matcher::synonyms(region)
             .into_iter()
             .map(str::to_string)

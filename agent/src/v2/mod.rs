@@ -199,8 +199,8 @@ fn settle(findings: &[Finding]) -> Outcome {
 /// the counts the instruction says and the regions it names for the `region` key
 /// (outside a conversation), directional orders only when it names a direction, orders
 /// by size only when it speaks of size. The same tests as the checks' ([`check::counts_said`],
-/// [`check::direction_said`]), so the grammar never offers what those checks would
-/// re-ask.
+/// [`check::region_said`], [`check::direction_said`], [`check::size_said`]), so the grammar
+/// never offers what those checks would re-ask.
 ///
 /// Colours are not narrowed: measured on people.nav, the default model gives most
 /// objects a colour, and with only the said colours on offer it gave them a said colour

@@ -380,6 +380,15 @@ pub fn default_backend(path: PathBuf) -> LlamaCppBackend {
     LlamaCppBackend::new(cfg).unwrap()
 }
 
+/// Says `texts` to session `id` one after another; its answers in order.
+async fn say_in_order(api: &Api, id: &str, texts: &[&str]) -> Replies {
+    let mut replies = Vec::new();
+    for text in texts {
+        replies.push(api.say(id, text, false).await);
+    }
+    replies
+}
+
 /// A session's answers: (status, body) per instruction.
 pub type Replies = Vec<(StatusCode, Value)>;
 
@@ -451,10 +460,8 @@ async fn record(model: PathBuf) -> Option<Recorded> {
     std::fs::create_dir_all(&dir).unwrap();
     let cassette = dir.join("smollm2-serve.jsonl");
     let _ = std::fs::remove_file(&cassette);
-    let mut cfg = LlamaCppConfig::new(model);
-    cfg.n_ctx = 8192;
     let backend: Arc<dyn LlmBackend> =
-        Arc::new(Recording::new(LlamaCppBackend::new(cfg).unwrap(), cassette.clone()).unwrap());
+        Arc::new(Recording::new(smol_backend(model), cassette.clone()).unwrap());
     let running = one_worker(backend).await;
     let api = running.api();
     // One listener sees the queue at work.
@@ -464,13 +471,7 @@ async fn record(model: PathBuf) -> Option<Recorded> {
     let watched = {
         let api = api.clone();
         let id = watch_id.clone();
-        tokio::spawn(async move {
-            let mut replies = Vec::new();
-            for text in SEQUENCES[0] {
-                replies.push(api.say(&id, text, false).await);
-            }
-            replies
-        })
+        tokio::spawn(async move { say_in_order(&api, &id, &SEQUENCES[0]).await })
     };
     let (others, mut ms) = run_sessions(&api, SEQUENCES.len() - 1, |i| i + 1).await;
     let first = watched.await.unwrap();
@@ -557,13 +558,9 @@ async fn replay_in_turn(cassette: &std::path::Path) -> Vec<Replies> {
     let running = one_worker(backend).await;
     let api = running.api();
     let mut all = Vec::new();
-    for seq in SEQUENCES {
+    for seq in &SEQUENCES {
         let id = api.session().await;
-        let mut replies = Vec::new();
-        for text in seq {
-            replies.push(api.say(&id, text, false).await);
-        }
-        all.push(replies);
+        all.push(say_in_order(&api, &id, seq).await);
     }
     running.stop().await;
     all
