@@ -108,6 +108,21 @@ impl ObjectOrder {
         }
     }
 
+    /// The directional order that starts at `side` ("north", "south", "east", "west",
+    /// "left", "right"): "the X furthest south" is the first in `south_to_north`.
+    #[must_use]
+    pub fn starting_at(side: &str) -> Option<ObjectOrder> {
+        Some(match side {
+            "north" => ObjectOrder::NorthToSouth,
+            "south" => ObjectOrder::SouthToNorth,
+            "west" => ObjectOrder::WestToEast,
+            "east" => ObjectOrder::EastToWest,
+            "left" => ObjectOrder::LeftToRight,
+            "right" => ObjectOrder::RightToLeft,
+            _ => return None,
+        })
+    }
+
     /// The order's snake_case name, e.g. `near_to_far`.
     pub fn name(self) -> &'static str {
         ObjectOrder::ALL
@@ -409,6 +424,38 @@ mod tests {
             assert_eq!(o.is_directional(), !by_size && !by_distance, "{name}");
             assert_eq!(o.reversed().is_by_size(), by_size, "{name}");
         }
+    }
+
+    #[test]
+    fn the_order_starting_at_a_side() {
+        // "the X furthest south" is the first south-first; the first of the order that
+        // starts at a side is the last of its reverse.
+        for (side, name) in [
+            ("north", "north_to_south"),
+            ("south", "south_to_north"),
+            ("west", "west_to_east"),
+            ("east", "east_to_west"),
+            ("left", "left_to_right"),
+            ("right", "right_to_left"),
+        ] {
+            let o = ObjectOrder::starting_at(side).unwrap();
+            assert_eq!(o.name(), name);
+            assert!(o.is_directional());
+            assert!(o.reversed().name().ends_with(side), "{side}");
+        }
+        for not_a_side in ["", "up", "North", "near", "largest"] {
+            assert_eq!(ObjectOrder::starting_at(not_a_side), None, "{not_a_side}");
+        }
+        // On the map below: the table furthest east is the first east-first and the
+        // last west-first (id 4 at x = 4).
+        let m = map();
+        let east = ObjectOrder::starting_at("east").unwrap();
+        let first = |o: ObjectOrder, k: i64| {
+            m.get_obj_attributes("table", k, None, o, AT_ORIGIN)
+                .map(|i| i.id)
+        };
+        assert_eq!(first(east, 1), Ok(4));
+        assert_eq!(first(east.reversed(), -1), Ok(4));
     }
 
     /// Robot at the origin facing north. Tables at x = 1..4 along y = 3, the

@@ -298,6 +298,22 @@ fn noun_after(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<(Strin
     })
 }
 
+/// The map object named right before the word at `i` ("the desk furthest west"), one or
+/// two words long, if the map holds it as an object (not a region): its label.
+fn noun_before(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<String> {
+    let mut candidates = Vec::new();
+    if i >= 2 {
+        candidates.push(format!("{} {}", w[i - 2], w[i - 1]));
+    }
+    if i >= 1 {
+        candidates.push(w[i - 1].clone());
+    }
+    candidates.into_iter().find_map(|n| {
+        let l = label_of(map, &n, pose)?;
+        (!map.regions.iter().any(|r| r.name == l)).then_some(l)
+    })
+}
+
 /// The instances the plan names by id (chat references).
 fn plan_instances(plan: &TypedPlan) -> Vec<u32> {
     plan.steps
@@ -394,17 +410,40 @@ fn check_words(
         }
         // Superlatives of distance.
         if matches!(word.as_str(), "farthest" | "furthest") {
-            let directional = directions.contains(&next);
+            // "furthest south": counted from that end, the first south-first or the last
+            // north-first (Qwen 1.5B on held-out v2 wrote "the shelf furthest north" as
+            // ordinal -1 in north_to_south, the southernmost, and a check that saw only
+            // a direction let it pass).
+            let end = directions
+                .contains(&next)
+                .then(|| ObjectOrder::starting_at(next))
+                .flatten();
+            if let Some(o) = end {
+                // On the object it is said of, when that object's name comes right before
+                // ("the desk furthest west"; held-out v2: another target's order let the
+                // desk's wrong end pass).
+                let of_noun = noun_before(map, &w, i, pose).filter(|l| {
+                    any_target(&|t| label_of(map, &t.name, pose).as_deref() == Some(l))
+                });
+                let counted = |t: &Target| {
+                    from_end(t, o)
+                        && of_noun
+                            .as_ref()
+                            .is_none_or(|l| label_of(map, &t.name, pose).as_deref() == Some(l))
+                };
+                if !any_target(&counted) {
+                    let ordered = any_target(&|t| t.order == o || t.order == o.reversed());
+                    out.push(not_counted_from(&format!("{word} {next}"), o, ordered));
+                }
+                continue;
+            }
             // From the far end: the last nearest-first, or the first farthest-first.
             // ordinal -1 in far_to_near is the nearest.
-            if !any_target(&|t| {
-                from_end(t, ObjectOrder::FarToNear)
-                    || (directional && t.order != ObjectOrder::NearToFar)
-            }) {
+            if !any_target(&|t| from_end(t, ObjectOrder::FarToNear)) {
                 let to_model = if any_target(&|t| t.order == ObjectOrder::FarToNear) {
                     format!("the person said \"{word}\", but ordinal -1 in order \"far_to_near\" is the nearest: for the {word} write ordinal: -1 alone (or ordinal: 1 with order \"far_to_near\")")
                 } else {
-                    format!("the person said \"{word}{}\", but no object in the plan is counted from that end (ordinal -1, or an order)", if directional { format!(" {next}") } else { String::new() })
+                    format!("the person said \"{word}\", but no object in the plan is counted from that end (ordinal -1, or an order)")
                 };
                 out.push(Finding::new(
                     FindingKind::Word,
@@ -423,16 +462,7 @@ fn check_words(
         if let Some(o) = size {
             if !any_target(&|t| from_end(t, o)) {
                 // ordinal -1 in largest_to_smallest is the smallest.
-                let to_model = if any_target(&|t| t.order == o) {
-                    format!("the person said \"{word}\", but ordinal -1 in order \"{}\" is the other end: for the {word} write ordinal: 1 with order \"{}\"", o.name(), o.name())
-                } else {
-                    format!("the person said \"{word}\", but no object in the plan is counted in the order \"{}\"", o.name())
-                };
-                out.push(Finding::new(
-                    FindingKind::Word,
-                    to_model,
-                    format!("which one is the {word}?"),
-                ));
+                out.push(not_counted_from(word, o, any_target(&|t| t.order == o)));
             }
             continue;
         }
@@ -524,6 +554,18 @@ fn check_words(
         }
     }
     out
+}
+
+/// The finding for a superlative (`said`: "biggest", "furthest west") that no target
+/// counts from the start of `o`; `ordered`: some target is counted in `o` or its reverse,
+/// from the other end.
+fn not_counted_from(said: &str, o: ObjectOrder, ordered: bool) -> Finding {
+    let to_model = if ordered {
+        format!("the person said \"{said}\", but the plan counts order \"{}\" from the other end: for the {said} write ordinal: 1 with order \"{}\"", o.name(), o.name())
+    } else {
+        format!("the person said \"{said}\", but no object in the plan is counted in the order \"{}\"", o.name())
+    };
+    Finding::new(FindingKind::Word, to_model, format!("which one is the {said}?"))
 }
 
 /// Whether `t` counts from the start of `order` ("the biggest": the first
@@ -999,6 +1041,22 @@ pub(crate) mod tests {
                 "#{ordinal: -1, order: \"far_to_near\"}",
                 "is the nearest",
             ),
+            // Held-out v2 ("the shelf furthest north" as the southernmost).
+            (
+                "go to the table furthest north",
+                "#{ordinal: -1, order: \"north_to_south\"}",
+                "write ordinal: 1 with order \"north_to_south\"",
+            ),
+            (
+                "go to the table furthest west",
+                "#{ordinal: 1, order: \"east_to_west\"}",
+                "write ordinal: 1 with order \"west_to_east\"",
+            ),
+            (
+                "go to the table furthest east",
+                "#{ordinal: -1}",
+                "no object in the plan is counted in the order \"east_to_west\"",
+            ),
         ] {
             let object = if instruction.contains("bed") {
                 "bed"
@@ -1034,6 +1092,19 @@ pub(crate) mod tests {
                 "go to the bed furthest from you",
                 "#{order: \"far_to_near\"}",
             ),
+            (
+                "go to the bed furthest north",
+                "#{ordinal: 1, order: \"north_to_south\"}",
+            ),
+            ("go to the bed furthest north", "#{order: \"north_to_south\"}"),
+            (
+                "go to the bed furthest north",
+                "#{ordinal: -1, order: \"south_to_north\"}",
+            ),
+            (
+                "go to the bed furthest to the left",
+                "#{ordinal: -1}",
+            ),
         ] {
             let f = findings(
                 instruction,
@@ -1044,6 +1115,22 @@ pub(crate) mod tests {
                 "{instruction} {select}: {f:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_directional_superlative_is_judged_on_its_object() {
+        // Held-out v2: "the desk furthest west" as the last west-first (the easternmost)
+        // passed, because another target (a shelf) had the order west_to_east.
+        let wrong = "objects: [(desk, 1, None, west_to_east), (shelf, None, white)]\nplan:\nmove_to_object(get_obj(\"desk\", #{ordinal: -1, order: \"west_to_east\"}));\nmove_south(get_obj(\"shelf\", #{colour: \"white\", order: \"west_to_east\"}));";
+        let f = findings("go to the desk furthest west, then south of the white shelf", wrong);
+        assert!(
+            f.iter().any(|x| x.kind == FindingKind::Word
+                && x.to_model.contains("write ordinal: 1 with order \"west_to_east\"")),
+            "{f:?}"
+        );
+        let right = wrong.replace("ordinal: -1", "ordinal: 1");
+        let f = findings("go to the desk furthest west, then south of the white shelf", &right);
+        assert!(f.iter().all(|x| x.kind != FindingKind::Word), "{f:?}");
     }
 
     #[test]
