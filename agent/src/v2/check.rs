@@ -563,9 +563,16 @@ fn not_counted_from(said: &str, o: ObjectOrder, ordered: bool) -> Finding {
     let to_model = if ordered {
         format!("the person said \"{said}\", but the plan counts order \"{}\" from the other end: for the {said} write ordinal: 1 with order \"{}\"", o.name(), o.name())
     } else {
-        format!("the person said \"{said}\", but no object in the plan is counted in the order \"{}\"", o.name())
+        format!(
+            "the person said \"{said}\", but no object in the plan is counted in the order \"{}\"",
+            o.name()
+        )
     };
-    Finding::new(FindingKind::Word, to_model, format!("which one is the {said}?"))
+    Finding::new(
+        FindingKind::Word,
+        to_model,
+        format!("which one is the {said}?"),
+    )
 }
 
 /// Whether `t` counts from the start of `order` ("the biggest": the first
@@ -1096,15 +1103,15 @@ pub(crate) mod tests {
                 "go to the bed furthest north",
                 "#{ordinal: 1, order: \"north_to_south\"}",
             ),
-            ("go to the bed furthest north", "#{order: \"north_to_south\"}"),
+            (
+                "go to the bed furthest north",
+                "#{order: \"north_to_south\"}",
+            ),
             (
                 "go to the bed furthest north",
                 "#{ordinal: -1, order: \"south_to_north\"}",
             ),
-            (
-                "go to the bed furthest to the left",
-                "#{ordinal: -1}",
-            ),
+            ("go to the bed furthest to the left", "#{ordinal: -1}"),
         ] {
             let f = findings(
                 instruction,
@@ -1122,14 +1129,21 @@ pub(crate) mod tests {
         // Held-out v2: "the desk furthest west" as the last west-first (the easternmost)
         // passed, because another target (a shelf) had the order west_to_east.
         let wrong = "objects: [(desk, 1, None, west_to_east), (shelf, None, white)]\nplan:\nmove_to_object(get_obj(\"desk\", #{ordinal: -1, order: \"west_to_east\"}));\nmove_south(get_obj(\"shelf\", #{colour: \"white\", order: \"west_to_east\"}));";
-        let f = findings("go to the desk furthest west, then south of the white shelf", wrong);
+        let f = findings(
+            "go to the desk furthest west, then south of the white shelf",
+            wrong,
+        );
         assert!(
             f.iter().any(|x| x.kind == FindingKind::Word
-                && x.to_model.contains("write ordinal: 1 with order \"west_to_east\"")),
+                && x.to_model
+                    .contains("write ordinal: 1 with order \"west_to_east\"")),
             "{f:?}"
         );
         let right = wrong.replace("ordinal: -1", "ordinal: 1");
-        let f = findings("go to the desk furthest west, then south of the white shelf", &right);
+        let f = findings(
+            "go to the desk furthest west, then south of the white shelf",
+            &right,
+        );
         assert!(f.iter().all(|x| x.kind != FindingKind::Word), "{f:?}");
     }
 
