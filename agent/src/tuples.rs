@@ -540,17 +540,15 @@ pub fn normalise_order(raw: &str) -> Option<String> {
     let n = n.trim_start_matches("from ").trim();
     let n = n.trim_start_matches("the ").trim();
     let n = n.trim_end_matches(" side").trim();
-    let word = match n {
-        "west" | "western" => Some("west_to_east"),
-        "east" | "eastern" => Some("east_to_west"),
-        "north" | "northern" => Some("north_to_south"),
-        "south" | "southern" => Some("south_to_north"),
-        "left" => Some("left_to_right"),
-        "right" => Some("right_to_left"),
-        _ => None,
+    let side = match n {
+        "western" => "west",
+        "eastern" => "east",
+        "northern" => "north",
+        "southern" => "south",
+        side => side,
     };
-    if let Some(w) = word {
-        return Some(w.to_string());
+    if let Some(o) = map_core::ObjectOrder::starting_at(side) {
+        return Some(o.name().to_string());
     }
     if let Some((_, o)) = SUPERLATIVES.iter().find(|(w, _)| *w == n) {
         return Some((*o).to_string());
@@ -741,6 +739,24 @@ mod tests {
         }
         assert!(parse_ordinal("-3").is_err());
         assert!(parse_ordinal("many").is_err());
+    }
+
+    #[test]
+    fn orders_from_sides_superlatives_and_names() {
+        for (raw, want) in [
+            ("west", Some("west_to_east")),
+            ("the western side", Some("west_to_east")),
+            ("counting from the north", Some("north_to_south")),
+            ("from the left", Some("left_to_right")),
+            ("right", Some("right_to_left")),
+            ("southern", Some("south_to_north")),
+            ("easternmost", Some("east_to_west")),
+            ("Largest to smallest", Some("largest_to_smallest")),
+            ("near_to_far", None),
+            ("upstairs", None),
+        ] {
+            assert_eq!(normalise_order(raw).as_deref(), want, "{raw}");
+        }
     }
 
     #[test]

@@ -292,10 +292,15 @@ fn noun_after(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<(Strin
         candidates.push(format!("{one} {two}"));
     }
     candidates.push(one.clone());
-    candidates.into_iter().find_map(|n| {
-        let l = label_of(map, &n, pose)?;
-        (!map.regions.iter().any(|r| r.name == l)).then_some((n, l))
-    })
+    candidates
+        .into_iter()
+        .find_map(|n| object_label(map, &n, pose).map(|l| (n, l)))
+}
+
+/// The label of the map object `n` names, unless it names a region.
+fn object_label(map: &IvlMap, n: &str, pose: Pose) -> Option<String> {
+    let l = label_of(map, n, pose)?;
+    (!map.regions.iter().any(|r| r.name == l)).then_some(l)
 }
 
 /// The map object named right before the word at `i` ("the desk furthest west"), one or
@@ -308,10 +313,9 @@ fn noun_before(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<Strin
     if i >= 1 {
         candidates.push(w[i - 1].clone());
     }
-    candidates.into_iter().find_map(|n| {
-        let l = label_of(map, &n, pose)?;
-        (!map.regions.iter().any(|r| r.name == l)).then_some(l)
-    })
+    candidates
+        .into_iter()
+        .find_map(|n| object_label(map, &n, pose))
 }
 
 /// The instances the plan names by id (chat references).
@@ -343,7 +347,6 @@ fn check_words(
     for (l, _) in map.label_counts() {
         name_words.extend(words(&l));
     }
-    let directions = ["north", "south", "east", "west", "left", "right"];
     let mut said: Vec<String> = Vec::new();
     for (i, word) in w.iter().enumerate() {
         let prev = if i > 0 { w[i - 1].as_str() } else { "" };
@@ -414,11 +417,7 @@ fn check_words(
             // north-first (Qwen 1.5B on held-out v2 wrote "the shelf furthest north" as
             // ordinal -1 in north_to_south, the southernmost, and a check that saw only
             // a direction let it pass).
-            let end = directions
-                .contains(&next)
-                .then(|| ObjectOrder::starting_at(next))
-                .flatten();
-            if let Some(o) = end {
+            if let Some(o) = ObjectOrder::starting_at(next) {
                 // On the object it is said of, when that object's name comes right before
                 // ("the desk furthest west"; held-out v2: another target's order let the
                 // desk's wrong end pass).
