@@ -890,6 +890,18 @@ pub(crate) fn unsaid_ordinals<'a>(
         .collect()
 }
 
+/// The targets that count from the end of `far_to_near` or of an order by size
+/// (a negative ordinal there): what a positive ordinal in the default order, or in the
+/// other size order, says the way it is said. The grammar offers only that way
+/// ([`super::grammar`]); the default model wrote the other for the opposite ("the bed
+/// that's farthest away" as `#{ordinal: -1, order: "far_to_near"}`, the nearest).
+pub(crate) fn counted_from_the_end(plan: &TypedPlan) -> Vec<&Target> {
+    targets(plan)
+        .into_iter()
+        .filter(|t| t.ordinal < 0 && (t.order == ObjectOrder::FarToNear || t.order.is_by_size()))
+        .collect()
+}
+
 /// What a finding tells the model about a target.
 type Note = dyn Fn(&Target) -> String;
 
@@ -972,6 +984,19 @@ pub fn check_answer(
             format!("which {} do you mean{how}", t.name)
         }));
     }
+    out.extend(unsaid_findings(
+        map,
+        pose,
+        counted_from_the_end(plan),
+        |t| {
+            let k = t.ordinal.unsigned_abs();
+            match t.order.reversed() {
+                ObjectOrder::NearToFar => format!("the plan picks the {} with ordinal {} in order \"far_to_near\", which counts from the near end: write ordinal: {k} (nearest first) for that, or ordinal: {} alone for the farthest", t.name, t.ordinal, t.ordinal),
+                o => format!("the plan picks the {} with ordinal {} in order \"{}\": write ordinal: {k} with order \"{}\" for that", t.name, t.ordinal, t.order.name(), o.name()),
+            }
+        },
+        |t| format!("which {} do you mean", t.name),
+    ));
     // A plan with no step that moves or turns does nothing the person asked for.
     if !plan
         .steps
@@ -1020,6 +1045,46 @@ pub(crate) mod tests {
         let m = map();
         let a = parse_answer(answer).unwrap();
         check_answer(&m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[])
+    }
+
+    #[test]
+    fn counting_from_the_end_of_far_to_near_or_of_a_size_order_is_found() {
+        // Either is what a positive ordinal says the way it is said (the grammar offers
+        // only that): "the bed that's farthest away" as the last far-to-near (the
+        // nearest), "the biggest bed" as the last smallest-first.
+        for (instruction, select, says) in [
+            (
+                "go to the bed that's farthest away",
+                "#{ordinal: -1, order: \"far_to_near\"}",
+                "write ordinal: 1 (nearest first) for that, or ordinal: -1 alone for the farthest",
+            ),
+            (
+                "go to the biggest bed",
+                "#{ordinal: -1, order: \"smallest_to_largest\"}",
+                "write ordinal: 1 with order \"largest_to_smallest\" for that",
+            ),
+            (
+                "go to the second smallest bed",
+                "#{ordinal: -2, order: \"largest_to_smallest\"}",
+                "write ordinal: 2 with order \"smallest_to_largest\" for that",
+            ),
+        ] {
+            let f = findings(
+                instruction,
+                &format!("objects: [(bed, None, None)]\nplan:\nmove_to_object(get_obj(\"bed\", {select}));"),
+            );
+            assert!(
+                f.iter()
+                    .any(|x| x.kind == FindingKind::Word && x.to_model.contains(says)),
+                "{instruction}: {f:?}"
+            );
+        }
+        // From the end of a direction, or of the default order, passes.
+        let f = findings(
+            "go to the penultimate bed from the west",
+            "objects: [(bed, 2, None, west_to_east)]\nplan:\nmove_to_object(get_obj(\"bed\", #{ordinal: -2, order: \"west_to_east\"}));",
+        );
+        assert!(!f.iter().any(|x| x.to_model.contains("for that")), "{f:?}");
     }
 
     #[test]
@@ -1084,10 +1149,6 @@ pub(crate) mod tests {
             (
                 "go to the biggest bed",
                 "#{ordinal: 1, order: \"largest_to_smallest\"}",
-            ),
-            (
-                "go to the biggest bed",
-                "#{ordinal: -1, order: \"smallest_to_largest\"}",
             ),
             (
                 "go to the second biggest bed",

@@ -283,6 +283,8 @@ mod tests {
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let unsaid = super::super::check::unsaid_regions(&e.instruction, in_chat, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
+            let from_end = super::super::check::counted_from_the_end(&a.plan);
+            assert!(from_end.is_empty(), "line {}: {from_end:?}", e.line);
             planner_dsl::Plan::compile(&a.plan.to_rhai())
                 .unwrap_or_else(|err| panic!("example at line {}: {err}", e.line));
         }

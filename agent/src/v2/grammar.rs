@@ -313,37 +313,60 @@ fn region_keys(vocab: &Vocabulary) -> &[String] {
 /// least one; colours from the rule `colour` (none: no colour keys). Its key rules are
 /// `sel0`, `sel1`... without a suffix (the names recorded cassettes hold) and
 /// `sel{suffix}_0`... with one.
+///
+/// A negative ordinal (counted from the end) goes on in a second chain of key rules
+/// (`seln1`...) whose order is `qordern`: no `far_to_near` and no order by size. Counting
+/// from the end of those orders says what a positive ordinal of the default order, or of
+/// the other size order, says, and the default model wrote it for the opposite ("the bed
+/// that's farthest away" as `#{ordinal: -1, order: "far_to_near"}`, the nearest bed;
+/// "the biggest bed" as the last largest-first, the smallest): one way to write each
+/// meaning, the one that reads as it is said ([`check`](super::check) finds the other).
 fn selection_rules(w: &mut Writer, suffix: &str, colour: Option<&str>, vocab: &Vocabulary) {
-    let mut keys = vec!["\"ordinal: \" int".to_string()];
-    if let Some(c) = colour {
-        keys.push(format!("\"colour: \" {c}"));
-        keys.push(format!("\"not_colour: \" {c}"));
-    }
-    keys.push("\"order: \" qorder".into());
-    if !region_keys(vocab).is_empty() {
-        keys.push("\"region: \" qregion".into());
-    }
-    keys.push("\"near: \" obj".into());
-    let sel = |i: usize| {
+    let keys = |order: &str| {
+        let mut keys = Vec::new();
+        if let Some(c) = colour {
+            keys.push(format!("\"colour: \" {c}"));
+            keys.push(format!("\"not_colour: \" {c}"));
+        }
+        keys.push(format!("\"order: \" {order}"));
+        if !region_keys(vocab).is_empty() {
+            keys.push("\"region: \" qregion".into());
+        }
+        keys.push("\"near: \" obj".into());
+        keys
+    };
+    let sel = |chain: &str, i: usize| {
         if suffix.is_empty() {
-            format!("sel{i}")
+            format!("sel{chain}{i}")
         } else {
-            format!("sel{suffix}_{i}")
+            format!("sel{suffix}{chain}_{i}")
         }
     };
     w.rule(
         &format!("selmap{suffix}"),
-        &format!("\"#{{\" {} \"}}\"", sel(0)),
+        &format!("\"#{{\" {} \"}}\"", sel("", 0)),
     );
-    let n = keys.len();
-    for (i, k) in keys.iter().enumerate() {
-        if i + 1 == n {
-            w.rule(&sel(i), k);
-        } else {
-            w.rule(
-                &sel(i),
-                &format!("{k} (\", \" {next})? | {next}", next = sel(i + 1)),
-            );
+    w.rule(
+        &sel("", 0),
+        &format!(
+            "\"ordinal: \" pint (\", \" {p})? | \"ordinal: \" nint (\", \" {n})? | {p}",
+            p = sel("", 1),
+            n = sel("n", 1)
+        ),
+    );
+    for (chain, order) in [("", "qorder"), ("n", "qordern")] {
+        let keys = keys(order);
+        let n = keys.len();
+        for (i, k) in keys.iter().enumerate() {
+            let i = i + 1;
+            if i == n {
+                w.rule(&sel(chain, i), k);
+            } else {
+                w.rule(
+                    &sel(chain, i),
+                    &format!("{k} (\", \" {next})? | {next}", next = sel(chain, i + 1)),
+                );
+            }
         }
     }
 }
@@ -464,14 +487,28 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
         .filter(|o| !vocab.no_sizes || ObjectOrder::parse(o).is_ok_and(|o| !o.is_by_size()))
         .collect();
     w.rule("qorder", &alt(&offered, true));
+    let from_end: Vec<&str> = offered
+        .iter()
+        .copied()
+        .filter(|o| {
+            ObjectOrder::parse(o).is_ok_and(|o| o != ObjectOrder::FarToNear && !o.is_by_size())
+        })
+        .collect();
+    w.rule("qordern", &alt(&from_end, true));
+    w.rule("int", "pint | nint");
     match vocab.ordinals.as_deref() {
-        Some(ks) if !ks.is_empty() => {
-            let ks: Vec<String> = ks.iter().map(i64::to_string).collect();
-            w.rule("int", &alt(&ks, false));
+        Some(ks) if ks.iter().any(|k| *k > 0) && ks.iter().any(|k| *k < 0) => {
+            let text = |f: fn(&i64) -> bool| -> Vec<String> {
+                ks.iter().filter(|k| f(k)).map(i64::to_string).collect()
+            };
+            w.rule("pint", &alt(&text(|k| *k > 0), false));
+            w.rule("nint", &alt(&text(|k| *k < 0), false));
         }
         _ => {
-            let int = w.pattern("\"-\"? [1-9] [0-9]?", "-?[1-9][0-9]?");
-            w.rule("int", &int);
+            let pint = w.pattern("[1-9] [0-9]?", "[1-9][0-9]?");
+            w.rule("pint", &pint);
+            let nint = w.pattern("\"-\" [1-9] [0-9]?", "-[1-9][0-9]?");
+            w.rule("nint", &nint);
         }
     }
     let num = w.pattern(
@@ -650,6 +687,34 @@ mod tests {
     }
 
     #[test]
+    fn a_count_from_the_end_is_offered_only_where_it_reads_as_said() {
+        let mut v = vocab();
+        v.ordinals = Some(vec![1, -1, 2, -2]);
+        for lark in [answer_lark(&vocab()), answer_lark(&v)] {
+            let answer = |sel: &str| {
+                format!("objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));")
+            };
+            for ok in [
+                "ordinal: -1",
+                "ordinal: -2, colour: \"red\", order: \"west_to_east\"",
+                "ordinal: 1, order: \"far_to_near\"",
+                "ordinal: 2, order: \"smallest_to_largest\"",
+                "ordinal: -1, near: get_obj(\"sofa\", #{ordinal: 1, order: \"far_to_near\"})",
+                "order: \"largest_to_smallest\"",
+            ] {
+                lark_accepts(&lark, &answer(ok)).unwrap_or_else(|e| panic!("{ok}: {e}"));
+            }
+            for bad in [
+                "ordinal: -1, order: \"far_to_near\"",
+                "ordinal: -2, colour: \"red\", order: \"largest_to_smallest\"",
+                "ordinal: -1, order: \"smallest_to_largest\"",
+            ] {
+                assert!(lark_accepts(&lark, &answer(bad)).is_err(), "{bad}");
+            }
+        }
+    }
+
+    #[test]
     fn every_worked_example_is_an_answer_the_grammar_accepts() {
         let variant = concat!(env!("CARGO_MANIFEST_DIR"), "/../prompts/variants/quoted");
         for (prompts, quoted) in [
@@ -745,7 +810,8 @@ mod tests {
             assert!(g.contains(&format!("\n{rule}: ")), "{rule}");
         }
         // Character classes are regular expressions in Lark.
-        assert!(g.contains("int: /-?[1-9][0-9]?/"), "{g}");
+        assert!(g.contains("pint: /[1-9][0-9]?/"), "{g}");
+        assert!(g.contains("nint: /-[1-9][0-9]?/"), "{g}");
         assert!(objects_lark().starts_with("start: objects \"\\n\"\n"));
     }
 

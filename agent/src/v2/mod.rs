@@ -369,14 +369,23 @@ mod tests {
                     .unwrap_or_default()
                     .to_string()
             };
-            let (qorder, int) = (rule("qorder"), rule("int"));
+            let (qorder, pint, nint) = (rule("qorder"), rule("pint"), rule("nint"));
             assert!(
                 qorder.contains("far_to_near")
                     && !qorder.contains("west_to_east")
                     && !qorder.contains("largest_to_smallest"),
                 "{g}"
             );
-            assert!(int.contains("\"-3\"") && !int.contains("\"2\""), "{g}");
+            assert!(
+                nint.contains("\"-3\"") && pint.contains("\"3\"") && !pint.contains("\"2\""),
+                "{g}"
+            );
+            // Counted from the end: not in far_to_near.
+            let qordern = rule("qordern");
+            assert!(
+                !qordern.contains("far_to_near") && qordern.contains("near_to_far"),
+                "{g}"
+            );
         }
 
         // No room named: no region key; a room named: that room only (a bare room name
