@@ -346,14 +346,16 @@ fn selection_rules(w: &mut Writer, suffix: &str, colour: Option<&str>, vocab: &V
         &format!("selmap{suffix}"),
         &format!("\"#{{\" {} \"}}\"", sel("", 0)),
     );
-    w.rule(
-        &sel("", 0),
-        &format!(
-            "\"ordinal: \" pint (\", \" {p})? | \"ordinal: \" nint (\", \" {n})? | {p}",
-            p = sel("", 1),
-            n = sel("n", 1)
-        ),
-    );
+    let (positive, negative) = ordinal_signs(vocab);
+    let mut first = Vec::new();
+    if positive {
+        first.push(format!("\"ordinal: \" pint (\", \" {})?", sel("", 1)));
+    }
+    if negative {
+        first.push(format!("\"ordinal: \" nint (\", \" {})?", sel("n", 1)));
+    }
+    first.push(sel("", 1));
+    w.rule(&sel("", 0), &first.join(" | "));
     for (chain, order) in [("", "qorder"), ("n", "qordern")] {
         let keys = keys(order);
         let n = keys.len();
@@ -368,6 +370,15 @@ fn selection_rules(w: &mut Writer, suffix: &str, colour: Option<&str>, vocab: &V
                 );
             }
         }
+    }
+}
+
+/// Whether a selection may count from the start and from the end: `vocab.ordinals`
+/// holds a positive and a negative count (`None` or empty: any count).
+fn ordinal_signs(vocab: &Vocabulary) -> (bool, bool) {
+    match vocab.ordinals.as_deref() {
+        Some(ks) if !ks.is_empty() => (ks.iter().any(|k| *k > 0), ks.iter().any(|k| *k < 0)),
+        _ => (true, true),
     }
 }
 
@@ -495,21 +506,32 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
         })
         .collect();
     w.rule("qordern", &alt(&from_end, true));
-    w.rule("int", "pint | nint");
-    match vocab.ordinals.as_deref() {
-        Some(ks) if ks.iter().any(|k| *k > 0) && ks.iter().any(|k| *k < 0) => {
-            let text = |f: fn(&i64) -> bool| -> Vec<String> {
-                ks.iter().filter(|k| f(k)).map(i64::to_string).collect()
-            };
-            w.rule("pint", &alt(&text(|k| *k > 0), false));
-            w.rule("nint", &alt(&text(|k| *k < 0), false));
+    let (positive, negative) = ordinal_signs(vocab);
+    let ints: Vec<&str> = [(positive, "pint"), (negative, "nint")]
+        .iter()
+        .filter(|(sign, _)| *sign)
+        .map(|(_, rule)| *rule)
+        .collect();
+    w.rule("int", &ints.join(" | "));
+    for (sign, rule, gbnf, regex) in [
+        (positive, "pint", "[1-9] [0-9]?", "[1-9][0-9]?"),
+        (negative, "nint", "\"-\" [1-9] [0-9]?", "-[1-9][0-9]?"),
+    ] {
+        if !sign {
+            continue;
         }
-        _ => {
-            let pint = w.pattern("[1-9] [0-9]?", "[1-9][0-9]?");
-            w.rule("pint", &pint);
-            let nint = w.pattern("\"-\" [1-9] [0-9]?", "-[1-9][0-9]?");
-            w.rule("nint", &nint);
-        }
+        let body = match vocab.ordinals.as_deref() {
+            Some(ks) if !ks.is_empty() => {
+                let ks: Vec<String> = ks
+                    .iter()
+                    .filter(|k| (**k > 0) == (rule == "pint"))
+                    .map(i64::to_string)
+                    .collect();
+                alt(&ks, false)
+            }
+            _ => w.pattern(gbnf, regex),
+        };
+        w.rule(rule, &body);
     }
     let num = w.pattern(
         "\"-\"? [0-9] [0-9]{0,2} (\".\" [0-9] [0-9]?)?",
@@ -684,6 +706,22 @@ mod tests {
         // The objects line of extraction (no map) bars them too.
         let g = objects_lark();
         assert!(g.contains("TWORD: "), "{g}");
+    }
+
+    #[test]
+    fn counts_of_one_sign_offer_that_sign_only() {
+        let mut v = vocab();
+        v.ordinals = Some(vec![2, 3]);
+        let g = answer_grammar(&v);
+        assert!(undefined_rules(&g).is_empty(), "{g}");
+        assert!(!g.contains("nint"), "{g}");
+        let lark = answer_lark(&v);
+        let answer = |sel: &str| {
+            format!("objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));")
+        };
+        lark_accepts(&lark, &answer("ordinal: 3")).unwrap();
+        assert!(lark_accepts(&lark, &answer("ordinal: 1")).is_err());
+        assert!(lark_accepts(&lark, &answer("ordinal: -2")).is_err());
     }
 
     #[test]
