@@ -898,8 +898,15 @@ pub(crate) fn unsaid_ordinals<'a>(
 pub(crate) fn counted_from_the_end(plan: &TypedPlan) -> Vec<&Target> {
     targets(plan)
         .into_iter()
-        .filter(|t| t.ordinal < 0 && (t.order == ObjectOrder::FarToNear || t.order.is_by_size()))
+        .filter(|t| t.ordinal < 0 && !end_reads_as_said(t.order))
         .collect()
+}
+
+/// Whether a count from the end of `order` reads as it is said: not in `far_to_near`
+/// and not in an order by size (see [`counted_from_the_end`]). The grammar offers a
+/// negative ordinal only in these orders.
+pub(crate) fn end_reads_as_said(order: ObjectOrder) -> bool {
+    order != ObjectOrder::FarToNear && !order.is_by_size()
 }
 
 /// What a finding tells the model about a target.
@@ -1047,6 +1054,24 @@ pub(crate) mod tests {
         check_answer(&m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[])
     }
 
+    /// The findings for a plan of one move to `object` picked with `select`.
+    fn findings_for_pick(instruction: &str, object: &str, select: &str) -> Vec<Finding> {
+        findings(
+            instruction,
+            &format!("objects: [({object}, None, None)]\nplan:\nmove_to_object(get_obj(\"{object}\", {select}));"),
+        )
+    }
+
+    /// Asserts that the pick of [`findings_for_pick`] gets a word finding saying `says`.
+    fn assert_word_finding(instruction: &str, object: &str, select: &str, says: &str) {
+        let f = findings_for_pick(instruction, object, select);
+        assert!(
+            f.iter()
+                .any(|x| x.kind == FindingKind::Word && x.to_model.contains(says)),
+            "{instruction}: {f:?}"
+        );
+    }
+
     #[test]
     fn counting_from_the_end_of_far_to_near_or_of_a_size_order_is_found() {
         // Either is what a positive ordinal says the way it is said (the grammar offers
@@ -1069,15 +1094,7 @@ pub(crate) mod tests {
                 "write ordinal: 2 with order \"smallest_to_largest\" for that",
             ),
         ] {
-            let f = findings(
-                instruction,
-                &format!("objects: [(bed, None, None)]\nplan:\nmove_to_object(get_obj(\"bed\", {select}));"),
-            );
-            assert!(
-                f.iter()
-                    .any(|x| x.kind == FindingKind::Word && x.to_model.contains(says)),
-                "{instruction}: {f:?}"
-            );
+            assert_word_finding(instruction, "bed", select, says);
         }
         // From the end of a direction, or of the default order, passes.
         let f = findings(
@@ -1134,15 +1151,7 @@ pub(crate) mod tests {
             } else {
                 "table"
             };
-            let f = findings(
-                instruction,
-                &format!("objects: [({object}, None, None)]\nplan:\nmove_to_object(get_obj(\"{object}\", {select}));"),
-            );
-            assert!(
-                f.iter()
-                    .any(|x| x.kind == FindingKind::Word && x.to_model.contains(says)),
-                "{instruction}: {f:?}"
-            );
+            assert_word_finding(instruction, object, select, says);
         }
         // Either end, counted the right way, passes.
         for (instruction, select) in [
@@ -1173,10 +1182,7 @@ pub(crate) mod tests {
             ),
             ("go to the bed furthest to the left", "#{ordinal: -1}"),
         ] {
-            let f = findings(
-                instruction,
-                &format!("objects: [(bed, None, None)]\nplan:\nmove_to_object(get_obj(\"bed\", {select}));"),
-            );
+            let f = findings_for_pick(instruction, "bed", select);
             assert!(
                 f.iter().all(|x| x.kind != FindingKind::Word),
                 "{instruction} {select}: {f:?}"

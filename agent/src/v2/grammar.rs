@@ -501,9 +501,7 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
     let from_end: Vec<&str> = offered
         .iter()
         .copied()
-        .filter(|o| {
-            ObjectOrder::parse(o).is_ok_and(|o| o != ObjectOrder::FarToNear && !o.is_by_size())
-        })
+        .filter(|o| ObjectOrder::parse(o).is_ok_and(super::check::end_reads_as_said))
         .collect();
     w.rule("qordern", &alt(&from_end, true));
     let (positive, negative) = ordinal_signs(vocab);
@@ -513,18 +511,24 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
         .map(|(_, rule)| *rule)
         .collect();
     w.rule("int", &ints.join(" | "));
-    for (sign, rule, gbnf, regex) in [
-        (positive, "pint", "[1-9] [0-9]?", "[1-9][0-9]?"),
-        (negative, "nint", "\"-\" [1-9] [0-9]?", "-[1-9][0-9]?"),
+    for (offered, is_positive, rule, gbnf, regex) in [
+        (positive, true, "pint", "[1-9] [0-9]?", "[1-9][0-9]?"),
+        (
+            negative,
+            false,
+            "nint",
+            "\"-\" [1-9] [0-9]?",
+            "-[1-9][0-9]?",
+        ),
     ] {
-        if !sign {
+        if !offered {
             continue;
         }
         let body = match vocab.ordinals.as_deref() {
             Some(ks) if !ks.is_empty() => {
                 let ks: Vec<String> = ks
                     .iter()
-                    .filter(|k| (**k > 0) == (rule == "pint"))
+                    .filter(|k| (**k > 0) == is_positive)
                     .map(i64::to_string)
                     .collect();
                 alt(&ks, false)
