@@ -228,6 +228,21 @@ impl IvlMap {
         v.sort();
         v
     }
+
+    /// The names of the regions holding an instance labelled `label` (its footprint
+    /// centroid inside the region, as a selection's `region` filter counts it), in the
+    /// map's order of regions.
+    pub fn regions_holding(&self, label: &str) -> Vec<&str> {
+        self.regions
+            .iter()
+            .filter(|r| {
+                self.instances
+                    .iter()
+                    .any(|i| i.label == label && r.polygon.contains(i.centroid))
+            })
+            .map(|r| r.name.as_str())
+            .collect()
+    }
 }
 
 /// Resolution of the counting order: centroid coordinates are compared after
@@ -358,6 +373,14 @@ mod tests {
             "t.scene.json",
         )
         .unwrap()
+    }
+
+    #[test]
+    fn regions_holding_a_label_count_centroids_inside() {
+        let m = IvlMap::from_scene(&scene());
+        // chair 2 at x = 1 is in the kitchen (x 0..3); chair 4 at x = 4 is not.
+        assert_eq!(m.regions_holding("chair"), ["kitchen"]);
+        assert!(m.regions_holding("table").is_empty());
     }
 
     #[test]

@@ -31,7 +31,7 @@ use crate::tuples::{parse_tuples, Tuple};
 use self::answer::{objects_part, parse_answer, Answer};
 use self::check::{check_answer, runtime_finding, Finding, FindingKind};
 use self::grammar::{
-    answer_grammar, answer_lark, label_names, objects_grammar, objects_lark, Vocabulary,
+    answer_grammar, answer_lark, name_groups, objects_grammar, objects_lark, Vocabulary,
 };
 
 /// The messages of one request: system (+ scene), the nearest worked examples, the
@@ -232,9 +232,7 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
 /// synonyms) sharing one list; a name's first group wins.
 fn colours_said_of(map: &map_core::IvlMap, instruction: &str) -> Vec<(Vec<String>, Vec<String>)> {
     let said = check::colour_said(instruction, &[]);
-    let mut groups: Vec<(Vec<String>, Vec<String>)> = Vec::new();
-    let mut seen: Vec<String> = Vec::new();
-    for (label, _) in map.label_counts() {
+    name_groups(map, |label| {
         let mut colours: Vec<String> = map
             .instances
             .iter()
@@ -244,18 +242,8 @@ fn colours_said_of(map: &map_core::IvlMap, instruction: &str) -> Vec<(Vec<String
             .collect();
         colours.sort();
         colours.dedup();
-        let mut names = label_names(label);
-        names.retain(|n| !seen.contains(n));
-        seen.extend(names.iter().cloned());
-        if names.is_empty() {
-            continue;
-        }
-        match groups.iter_mut().find(|(_, c)| *c == colours) {
-            Some((n, _)) => n.extend(names),
-            None => groups.push((names, colours)),
-        }
-    }
-    groups
+        colours
+    })
 }
 
 /// Plans one instruction with one model call (and at most one re-ask).
