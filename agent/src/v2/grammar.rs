@@ -765,6 +765,17 @@ mod tests {
         }
     }
 
+    /// Asserts that `lark` accepts `answer(x)` for each `x` of `ok` and rejects it for each
+    /// of `barred`.
+    fn assert_offers(lark: &str, answer: impl Fn(&str) -> String, ok: &[&str], barred: &[&str]) {
+        for x in ok {
+            lark_accepts(lark, &answer(x)).unwrap_or_else(|e| panic!("{x}: {e}"));
+        }
+        for x in barred {
+            assert!(lark_accepts(lark, &answer(x)).is_err(), "{x} is offered");
+        }
+    }
+
     /// The vocabulary of the worked examples themselves (their names, colours and rooms,
     /// what a map would supply, and the ids their conversations visited).
     fn examples_vocabulary(examples: &[crate::v2::examples::WorkedExample]) -> Vocabulary {
@@ -834,9 +845,12 @@ mod tests {
         let answer = |sel: &str| {
             format!("objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));")
         };
-        lark_accepts(&lark, &answer("ordinal: 3")).unwrap();
-        assert!(lark_accepts(&lark, &answer("ordinal: 1")).is_err());
-        assert!(lark_accepts(&lark, &answer("ordinal: -2")).is_err());
+        assert_offers(
+            &lark,
+            answer,
+            &["ordinal: 3"],
+            &["ordinal: 1", "ordinal: -2"],
+        );
     }
 
     #[test]
@@ -847,23 +861,23 @@ mod tests {
             let answer = |sel: &str| {
                 format!("objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));")
             };
-            for ok in [
-                "ordinal: -1",
-                "ordinal: -2, colour: \"red\", order: \"west_to_east\"",
-                "ordinal: 1, order: \"far_to_near\"",
-                "ordinal: 2, order: \"smallest_to_largest\"",
-                "ordinal: -1, near: get_obj(\"sofa\", #{ordinal: 1, order: \"far_to_near\"})",
-                "order: \"largest_to_smallest\"",
-            ] {
-                lark_accepts(&lark, &answer(ok)).unwrap_or_else(|e| panic!("{ok}: {e}"));
-            }
-            for bad in [
-                "ordinal: -1, order: \"far_to_near\"",
-                "ordinal: -2, colour: \"red\", order: \"largest_to_smallest\"",
-                "ordinal: -1, order: \"smallest_to_largest\"",
-            ] {
-                assert!(lark_accepts(&lark, &answer(bad)).is_err(), "{bad}");
-            }
+            assert_offers(
+                &lark,
+                answer,
+                &[
+                    "ordinal: -1",
+                    "ordinal: -2, colour: \"red\", order: \"west_to_east\"",
+                    "ordinal: 1, order: \"far_to_near\"",
+                    "ordinal: 2, order: \"smallest_to_largest\"",
+                    "ordinal: -1, near: get_obj(\"sofa\", #{ordinal: 1, order: \"far_to_near\"})",
+                    "order: \"largest_to_smallest\"",
+                ],
+                &[
+                    "ordinal: -1, order: \"far_to_near\"",
+                    "ordinal: -2, colour: \"red\", order: \"largest_to_smallest\"",
+                    "ordinal: -1, order: \"smallest_to_largest\"",
+                ],
+            );
         }
     }
 
@@ -992,43 +1006,38 @@ mod tests {
         let answer = |pick: &str| format!("objects: []\nplan:\nmove_to_object({pick});");
         // flat-a: the one tv is in the living room, the fridge in the kitchen, plants in
         // four rooms; synonyms follow their label.
-        for ok in [
-            "get_obj(\"tv\", #{region: \"living room\"})",
-            "get_obj(\"television\", #{region: \"living room\"})",
-            "get_obj(\"fridge\", #{colour: \"silver\", region: \"kitchen\"})",
-            "get_obj(\"plant\", #{ordinal: 2, region: \"office\"})",
-            "get_obj(\"chair\", #{near: get_obj(\"plant\", #{region: \"bedroom\"})})",
-            "get_obj(\"tv\")",
-            "\"bathroom\"",
-        ] {
-            lark_accepts(&lark, &answer(ok)).unwrap_or_else(|e| panic!("{ok}: {e}"));
-        }
-        for barred in [
-            "get_obj(\"tv\", #{region: \"kitchen\"})",
-            "get_obj(\"television\", #{region: \"office\"})",
-            "get_obj(\"refrigerator\", #{region: \"bathroom\"})",
-            "get_obj(\"chair\", #{near: get_obj(\"plant\", #{region: \"kitchen\"})})",
-        ] {
-            assert!(
-                lark_accepts(&lark, &answer(barred)).is_err(),
-                "{barred} is offered"
-            );
-        }
-        // The room narrowing still applies on top: no room said, no region key.
+        assert_offers(
+            &lark,
+            answer,
+            &[
+                "get_obj(\"tv\", #{region: \"living room\"})",
+                "get_obj(\"television\", #{region: \"living room\"})",
+                "get_obj(\"fridge\", #{colour: \"silver\", region: \"kitchen\"})",
+                "get_obj(\"plant\", #{ordinal: 2, region: \"office\"})",
+                "get_obj(\"chair\", #{near: get_obj(\"plant\", #{region: \"bedroom\"})})",
+                "get_obj(\"tv\")",
+                "\"bathroom\"",
+            ],
+            &[
+                "get_obj(\"tv\", #{region: \"kitchen\"})",
+                "get_obj(\"television\", #{region: \"office\"})",
+                "get_obj(\"refrigerator\", #{region: \"bathroom\"})",
+                "get_obj(\"chair\", #{near: get_obj(\"plant\", #{region: \"kitchen\"})})",
+            ],
+        );
+        // The said-room narrowing still applies on top: only the kitchen said, so the tv
+        // (in the living room) gets no region key at all.
         let mut said = v.clone();
         said.region_keys = Some(vec!["kitchen".into()]);
-        let lark = answer_lark(&said);
-        lark_accepts(
-            &lark,
-            &answer("get_obj(\"fridge\", #{region: \"kitchen\"})"),
-        )
-        .unwrap();
-        for barred in [
-            "get_obj(\"tv\", #{region: \"living room\"})",
-            "get_obj(\"tv\", #{region: \"kitchen\"})",
-        ] {
-            assert!(lark_accepts(&lark, &answer(barred)).is_err(), "{barred}");
-        }
+        assert_offers(
+            &answer_lark(&said),
+            answer,
+            &["get_obj(\"fridge\", #{region: \"kitchen\"})"],
+            &[
+                "get_obj(\"tv\", #{region: \"living room\"})",
+                "get_obj(\"tv\", #{region: \"kitchen\"})",
+            ],
+        );
     }
 
     #[test]
