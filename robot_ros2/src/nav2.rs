@@ -34,7 +34,7 @@ use crate::msgs::{
     TfMessage, Time,
 };
 use crate::tf::{PoseSource, TfState};
-use crate::wait::with_timeout;
+use crate::wait::with_retries;
 
 /// How the driver connects and how long it waits.
 #[derive(Debug, Clone)]
@@ -80,6 +80,9 @@ pub const MAX_DOMAIN_ID: u16 = 232;
 
 /// How often the goal loop looks at the middleware.
 const POLL: Duration = Duration::from_millis(10);
+/// How often the wait for the action server checks the match state again
+/// (`wait::with_retries`).
+const RECHECK: Duration = Duration::from_millis(250);
 
 enum NavClient {
     Humble(ActionClient<NavigateToPoseGoal, NavigateToPoseResultHumble, NavigateToPoseFeedback>),
@@ -217,8 +220,12 @@ impl Nav2Robot {
 
         let waited = opts.server_timeout;
         let found = match &client {
-            NavClient::Humble(c) => with_timeout(c.goal_client().wait_for_service(&node), waited),
-            NavClient::Jazzy(c) => with_timeout(c.goal_client().wait_for_service(&node), waited),
+            NavClient::Humble(c) => {
+                with_retries(|| c.goal_client().wait_for_service(&node), waited, RECHECK)
+            }
+            NavClient::Jazzy(c) => {
+                with_retries(|| c.goal_client().wait_for_service(&node), waited, RECHECK)
+            }
         };
         if found.is_none() {
             return Err(Ros2Error::NoActionServer {
