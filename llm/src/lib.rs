@@ -303,6 +303,19 @@ pub enum LlmError {
         /// Why (llama.cpp logs the parse error at `warn`/`error` level in tracing).
         message: String,
     },
+    /// The sampler stopped holding the answer to its grammar: llguidance could not compute
+    /// a token mask (it ran out of lexer fuel on a costly regular expression) and the model
+    /// wrote a token the grammar does not allow. A defect of the grammar, not of the model.
+    #[error(
+        "the answer left its grammar after {after_bytes} bytes ({reason}): the grammar is too \
+         costly for llguidance to follow"
+    )]
+    GrammarNotHeld {
+        /// How much of the answer the grammar held.
+        after_bytes: usize,
+        /// llguidance's reason for the token it refused.
+        reason: String,
+    },
     /// The prompt does not fit the context window.
     #[error(
         "prompt is {prompt_tokens} tokens but the context window holds {n_ctx}: \

@@ -516,7 +516,13 @@ fn choose_slot(slots: &[Slot], tokens: &[LlamaToken]) -> (usize, usize) {
 /// the sampled tokens to find the tokens the grammar forces (fast-forward).
 struct Sampling {
     chain: LlamaSampler,
-    shadow: Option<llguidance::Matcher>,
+    /// A clone of the Lark matcher that follows every token the chain samples. llama-cpp-2's
+    /// llguidance sampler masks nothing once its matcher fails (llguidance runs out of
+    /// lexer fuel on a costly regular expression, "too many expressions constructed"),
+    /// and the rest of the answer is then sampled without the grammar; the follower fails
+    /// on the same token, and the request fails with [`LlmError::GrammarNotHeld`] instead of
+    /// returning an answer the grammar never held.
+    follower: Option<llguidance::Matcher>,
 }
 
 impl Worker<'_> {
@@ -548,12 +554,10 @@ impl Worker<'_> {
 
     fn sampler(&mut self, req: &CompletionRequest) -> Result<Sampling, LlmError> {
         let mut chain = Vec::new();
-        let mut shadow = None;
+        let mut follower = None;
         if let Some(lark) = &req.lark {
             let m = self.lark_matcher(lark)?;
-            if self.cfg.fast_forward {
-                shadow = Some(m.deep_clone());
-            }
+            follower = Some(m.deep_clone());
             chain.push(LlamaSampler::from(m));
         }
         let grammar = match (&req.grammar, &req.json_schema) {
@@ -588,7 +592,7 @@ impl Worker<'_> {
         }
         Ok(Sampling {
             chain: LlamaSampler::chain_simple(chain),
-            shadow,
+            follower,
         })
     }
 
@@ -737,8 +741,9 @@ impl Worker<'_> {
         // Build the sampler first: a bad grammar fails before the cache is touched.
         let Sampling {
             chain: mut sampler,
-            mut shadow,
+            mut follower,
         } = self.sampler(req)?;
+        let fast_forward = self.cfg.fast_forward;
 
         let max_new = (req.max_tokens as usize).min(n_ctx - tokens.len());
 
@@ -832,9 +837,21 @@ impl Worker<'_> {
             // llama-cpp-2's token environment is not a canonical tokenizer, so llguidance
             // gives the forced bytes; they are tokenized here with the model's vocabulary.
             let mut forced: Vec<LlamaToken> = Vec::new();
-            let mut lost = false;
-            if let Some(m) = shadow.as_mut() {
-                if m.consume_token(tok.0.cast_unsigned()).is_ok() {
+            // (A matcher that has finished its grammar takes no more tokens; the sampler's
+            // own matcher skips them too.)
+            if let Some(m) = follower
+                .as_mut()
+                .filter(|m| m.is_error() || !m.is_stopped())
+            {
+                if m.consume_token(tok.0.cast_unsigned()).is_err() {
+                    let why = m.get_error().unwrap_or_default();
+                    let why = why.lines().next().unwrap_or_default();
+                    return Err(LlmError::GrammarNotHeld {
+                        after_bytes: out.len(),
+                        reason: why.to_string(),
+                    });
+                }
+                if fast_forward {
                     let room = (max_new - n_gen).min(n_batch.saturating_sub(1));
                     let bytes = m.compute_ff_bytes();
                     if !bytes.is_empty() {
@@ -846,16 +863,12 @@ impl Worker<'_> {
                         forced.pop();
                         forced.truncate(room);
                         let ids: Vec<u32> = forced.iter().map(|t| t.0.cast_unsigned()).collect();
-                        if m.consume_tokens(&ids).is_err() {
-                            // The shadow cannot follow: stop fast-forwarding for this answer.
-                            forced.clear();
-                            lost = true;
-                        }
+                        // Only the forced tokens the grammar takes as tokenized here go
+                        // ahead; the rest are sampled.
+                        let taken = m.try_consume_tokens(&ids).unwrap_or(0);
+                        forced.truncate(taken);
                     }
                 }
-            }
-            if lost {
-                shadow = None;
             }
             batch.clear();
             let step: Vec<LlamaToken> =

@@ -288,6 +288,53 @@ fn a_lark_grammar_runs_under_llguidance_with_forced_tokens_fast_forwarded() {
     assert!(b.complete(&req).is_ok());
 }
 
+/// `n` made-up five-letter words (a fixed sequence).
+fn made_up_words(n: usize) -> Vec<String> {
+    let mut x: u32 = 12345;
+    (0..n)
+        .map(|_| {
+            (0..5)
+                .map(|_| {
+                    x = x.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+                    char::from(b'a' + u8::try_from((x >> 16) % 26).unwrap())
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn a_lark_grammar_that_llguidance_cannot_hold_fails_the_request() {
+    let _g = serial();
+    let Some(b) = smol(2048) else { return };
+    // A regular expression less many substrings costs llguidance more lexer fuel
+    // than one step may spend ("too many expressions constructed"); llama-cpp-2's sampler
+    // then masks nothing, and the model writes what it likes. The request fails instead
+    // of returning what the grammar never held.
+    // (Measured with llguidance 1.9: 20 words are held, 50 and 100 are not, 200 are
+    // rejected when the grammar is built.)
+    let words = made_up_words(80).join("|");
+    let mut req = ask("Answer with a few words.", "Name some animals.", 24);
+    req.lark = Some(format!(
+        "start: \"animals: \" WORDS\nWORDS: /[a-z]{{1,12}}( [a-z]{{1,12}}){{0,5}}/ & ~/.*({words}).*/"
+    ));
+    match b.complete(&req) {
+        Err(LlmError::GrammarNotHeld {
+            after_bytes,
+            reason,
+        }) => {
+            // "animals: " is forced, so the grammar held at least that much.
+            assert!(after_bytes >= "animals: ".len(), "{after_bytes}");
+            assert!(reason.contains("doesn't satisfy the grammar"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    // The backend keeps working.
+    req.lark = Some(r#"start: "animals: " /[a-z]{1,12}/"#.into());
+    let c = b.complete(&req).unwrap();
+    assert!(c.text.starts_with("animals: "), "{c:?}");
+}
+
 #[test]
 fn json_schema_becomes_a_grammar() {
     let _g = serial();
