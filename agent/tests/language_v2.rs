@@ -120,6 +120,41 @@ fn a_disagreement_gets_one_targeted_reask() {
 }
 
 #[test]
+fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let red_sofa =
+        "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\n";
+    let b = Scripted::new(&[red_sofa, BLACK_SOFA_RIGHT]);
+    let out = plan_instruction(
+        &b,
+        &Prompts::builtin(),
+        "take me to the sofa, the black one",
+        &v2(&map, &robot),
+    )
+    .unwrap();
+    assert!(out.plan().is_some(), "{out:?}");
+    let reqs = b.requests();
+    assert_eq!(reqs.len(), 2);
+    // The re-ask's grammars are the first request's less what the finding bars (which
+    // colours: `agent::v2`'s unit test `a_reask_bars_the_unsaid_colours_of_the_label_a_finding_names`).
+    assert_ne!(reqs[1].lark, reqs[0].lark);
+    assert_ne!(reqs[1].grammar, reqs[0].grammar);
+    // A finding that bars nothing (a said colour left out) keeps the first grammar.
+    let b = Scripted::new(&[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT]);
+    plan_instruction(
+        &b,
+        &Prompts::builtin(),
+        "take me to the sofa, the black one",
+        &v2(&map, &robot),
+    )
+    .unwrap();
+    let reqs = b.requests();
+    assert_eq!(reqs[1].lark, reqs[0].lark);
+    assert_eq!(reqs[1].grammar, reqs[0].grammar);
+}
+
+#[test]
 fn a_second_disagreement_becomes_a_question_not_a_guess() {
     let map = flat_a();
     let robot = SimRobot::new(map.clone());

@@ -663,7 +663,7 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     fn vocab() -> Vocabulary {
@@ -748,7 +748,7 @@ mod tests {
 
     /// Whether the Lark grammar accepts `text` in full (llguidance's matcher, one byte per
     /// token).
-    fn lark_accepts(lark: &str, text: &str) -> Result<(), String> {
+    pub(crate) fn lark_accepts(lark: &str, text: &str) -> Result<(), String> {
         let env = llguidance::toktrie::ApproximateTokEnv::single_byte_env();
         let factory = llguidance::ParserFactory::new_simple(&env).map_err(|e| e.to_string())?;
         let grammar = llguidance::api::TopLevelGrammar::from_lark(lark.to_string());

@@ -19,7 +19,7 @@ pub mod grammar;
 use std::time::Instant;
 
 use llm::{ChatMessage, CompletionRequest, LlmBackend};
-use map_core::StopTarget;
+use map_core::{Pose, StopTarget};
 use planner_dsl::{Limits, Plan};
 
 use crate::pipeline::{
@@ -246,6 +246,64 @@ fn colours_said_of(map: &map_core::IvlMap, instruction: &str) -> Vec<(Vec<String
     })
 }
 
+/// The vocabulary of the re-ask after `findings`: `vocab` less the forms the findings
+/// bar ([`check::Bar`]); `None` when none bars anything. `known` are the colours of what
+/// the conversation visited (said, for the colour bar).
+///
+/// A barred label keeps the colours the person said, less those said only of another
+/// object ("a white chair" for a stool): measured on held-out v2's hd07 ("third stool
+/// please, then a white chair"), with every said colour left on offer the re-ask moved
+/// the chair's white onto the stool.
+fn reask_vocabulary(
+    vocab: &Vocabulary,
+    map: &map_core::IvlMap,
+    instruction: &str,
+    known: &[String],
+    findings: &[Finding],
+    pose: Pose,
+) -> Option<Vocabulary> {
+    let barred: Vec<&str> = findings
+        .iter()
+        .filter_map(|f| f.bar.as_ref())
+        .map(|b| match b {
+            check::Bar::UnsaidColours { label } => label.as_str(),
+        })
+        .collect();
+    if barred.is_empty() {
+        return None;
+    }
+    let said = check::colour_said(instruction, known);
+    let said_of = check::colours_said_of(map, instruction, pose);
+    // Said of objects, but never of one of `label`.
+    let elsewhere = |c: &str, label: &str| {
+        let of: Vec<&String> = said_of
+            .iter()
+            .filter(|(x, _)| check::same_colour(Some(x), c))
+            .map(|(_, l)| l)
+            .collect();
+        !of.is_empty() && of.iter().all(|l| l.as_str() != label)
+    };
+    let mut v = vocab.clone();
+    v.colours_of = Some(name_groups(map, |label| {
+        let first = grammar::label_names(label.to_string());
+        let mut list = vocab
+            .colours_of
+            .as_ref()
+            .and_then(|groups| {
+                groups
+                    .iter()
+                    .find(|(names, _)| first.iter().any(|n| names.contains(n)))
+                    .map(|(_, l)| l.clone())
+            })
+            .unwrap_or_else(|| vocab.colours.clone());
+        if barred.contains(&label) {
+            list.retain(|c| said(c) && !elsewhere(c, label));
+        }
+        list
+    }));
+    Some(v)
+}
+
 /// Plans one instruction with one model call (and at most one re-ask).
 ///
 /// # Errors
@@ -275,8 +333,14 @@ pub fn plan_instruction(
         }
         v
     };
-    let grammar = ctx.options.answer_grammar.then(|| answer_grammar(&vocab));
-    let lark = (ctx.options.answer_grammar && ctx.options.llguidance).then(|| answer_lark(&vocab));
+    let grammar_of = |v: &Vocabulary| {
+        (
+            ctx.options.answer_grammar.then(|| answer_grammar(v)),
+            (ctx.options.answer_grammar && ctx.options.llguidance).then(|| answer_lark(v)),
+        )
+    };
+    let (mut grammar, mut lark) = grammar_of(&vocab);
+    let known = check::colours_of(ctx.map, &ctx.references);
     let mut timing = Timing::default();
     let mut attempts = Vec::new();
     let mut findings = Vec::new();
@@ -314,6 +378,11 @@ pub fn plan_instruction(
                 let reask = prompts.v2_reask(&notes)?;
                 if let Some(last) = msgs.last_mut() {
                     last.content = format!("{}\n{}", last.content, reask.content);
+                }
+                if let Some(v) =
+                    reask_vocabulary(&vocab, ctx.map, instruction, &known, &f, ctx.pose())
+                {
+                    (grammar, lark) = grammar_of(&v);
                 }
                 findings = f;
             }
@@ -449,6 +518,71 @@ mod tests {
         let mut v = Vocabulary::for_map(&m);
         narrow_to_words(&mut v, "go to the red sofa", &ctx);
         assert_eq!(v.colours_of, None);
+    }
+
+    #[test]
+    fn a_reask_bars_the_unsaid_colours_of_the_label_a_finding_names() {
+        let m = map();
+        let v = Vocabulary::for_map(&m);
+        let instruction = "go to the chair, the yellow one, then the grey couch";
+        let answer = parse_answer(
+            "objects: [(chair, None, red), (couch, None, grey)]\nplan:\nmove_to_object(get_obj(\"chair\", #{colour: \"red\"}));\nmove_to_object(get_obj(\"couch\", #{colour: \"grey\"}));",
+        )
+        .unwrap();
+        let f = check_answer(
+            &m,
+            instruction,
+            &answer.tuples,
+            &answer.plan,
+            m.start_pose,
+            &[],
+            &[],
+        );
+        assert!(f.iter().any(|x| x.bar.is_some()), "{f:?}");
+        let r = reask_vocabulary(&v, &m, instruction, &[], &f, m.start_pose).unwrap();
+        let lark = answer_lark(&r);
+        let pick = |sel: &str| {
+            format!("objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj({sel}));")
+        };
+        // The chair may take a said colour that is not said of another object ("grey
+        // couch"), or none; other names keep every colour.
+        for ok in [
+            r#""chair", #{colour: "yellow"}"#,
+            r#""chair""#,
+            r#""sofa", #{colour: "red"}"#,
+            r#""couch", #{not_colour: "black"}"#,
+        ] {
+            grammar::tests::lark_accepts(&lark, &pick(ok)).unwrap_or_else(|e| panic!("{ok}: {e}"));
+        }
+        for barred in [
+            r#""chair", #{colour: "red"}"#,
+            r#""chair", #{not_colour: "black"}"#,
+            r#""chair", #{colour: "grey"}"#,
+        ] {
+            assert!(
+                grammar::tests::lark_accepts(&lark, &pick(barred)).is_err(),
+                "{barred}"
+            );
+            assert!(
+                grammar::tests::lark_accepts(&answer_lark(&v), &pick(barred)).is_ok(),
+                "the first request offers {barred}"
+            );
+        }
+        // A finding that bars nothing keeps the first request's grammar.
+        let mut plain = f.clone();
+        plain.iter_mut().for_each(|x| x.bar = None);
+        assert_eq!(
+            reask_vocabulary(&v, &m, instruction, &[], &plain, m.start_pose),
+            None
+        );
+        // What the conversation visited counts as said.
+        let r =
+            reask_vocabulary(&v, &m, instruction, &["red".to_string()], &f, m.start_pose).unwrap();
+        assert!(grammar::tests::lark_accepts(
+            &answer_lark(&r),
+            &pick(r#""chair", #{colour: "red"}"#)
+        )
+        .is_ok());
     }
 
     #[test]
