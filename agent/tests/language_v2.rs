@@ -78,6 +78,16 @@ impl LlmBackend for Scripted {
     }
 }
 
+/// Plans `instruction` on flat-a (a simulated robot at its start) with the model's
+/// answers fixed to `answers`; the outcome and every request made.
+fn plan_scripted(answers: &[&str], instruction: &str) -> (Outcome, Vec<CompletionRequest>) {
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let b = Scripted::new(answers);
+    let out = plan_instruction(&b, &Prompts::builtin(), instruction, &v2(&map, &robot)).unwrap();
+    (out, b.requests())
+}
+
 // flat-a's nearest sofa from the start is the red one: a plan that drops "black" goes
 // there, and the checks (the words, and the instance the dry run reaches) say so.
 const BLACK_SOFA_WRONG: &str =
@@ -87,20 +97,14 @@ const BLACK_SOFA_RIGHT: &str =
 
 #[test]
 fn a_disagreement_gets_one_targeted_reask() {
-    let map = flat_a();
-    let robot = SimRobot::new(map.clone());
-    let b = Scripted::new(&[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT]);
-    let out = plan_instruction(
-        &b,
-        &Prompts::builtin(),
+    let (out, reqs) = plan_scripted(
+        &[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT],
         "take me to the sofa, the black one",
-        &v2(&map, &robot),
-    )
-    .unwrap();
+    );
     let p = out.plan().expect("a plan after the re-ask");
     assert_eq!(p.source, PlanSource::Llm { repairs: 1 });
     assert_eq!(p.timing.llm_calls, 2);
-    let reqs = b.requests();
+
     assert_eq!(reqs.len(), 2);
     let reask = reqs[1].messages.last().unwrap();
     assert_eq!(reask.role, Role::User);
@@ -121,51 +125,34 @@ fn a_disagreement_gets_one_targeted_reask() {
 
 #[test]
 fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
-    let map = flat_a();
-    let robot = SimRobot::new(map.clone());
     let red_sofa =
         "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\n";
-    let b = Scripted::new(&[red_sofa, BLACK_SOFA_RIGHT]);
-    let out = plan_instruction(
-        &b,
-        &Prompts::builtin(),
+    let (out, reqs) = plan_scripted(
+        &[red_sofa, BLACK_SOFA_RIGHT],
         "take me to the sofa, the black one",
-        &v2(&map, &robot),
-    )
-    .unwrap();
+    );
     assert!(out.plan().is_some(), "{out:?}");
-    let reqs = b.requests();
+
     assert_eq!(reqs.len(), 2);
     // The re-ask's grammars are the first request's less what the finding bars (which
     // colours: `agent::v2`'s unit test `a_reask_bars_the_unsaid_colours_of_the_label_a_finding_names`).
     assert_ne!(reqs[1].lark, reqs[0].lark);
     assert_ne!(reqs[1].grammar, reqs[0].grammar);
     // A finding that bars nothing (a said colour left out) keeps the first grammar.
-    let b = Scripted::new(&[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT]);
-    plan_instruction(
-        &b,
-        &Prompts::builtin(),
+    let (_, reqs) = plan_scripted(
+        &[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT],
         "take me to the sofa, the black one",
-        &v2(&map, &robot),
-    )
-    .unwrap();
-    let reqs = b.requests();
+    );
     assert_eq!(reqs[1].lark, reqs[0].lark);
     assert_eq!(reqs[1].grammar, reqs[0].grammar);
 }
 
 #[test]
 fn a_second_disagreement_becomes_a_question_not_a_guess() {
-    let map = flat_a();
-    let robot = SimRobot::new(map.clone());
-    let b = Scripted::new(&[BLACK_SOFA_WRONG, BLACK_SOFA_WRONG]);
-    let out = plan_instruction(
-        &b,
-        &Prompts::builtin(),
+    let (out, reqs) = plan_scripted(
+        &[BLACK_SOFA_WRONG, BLACK_SOFA_WRONG],
         "take me to the sofa, the black one",
-        &v2(&map, &robot),
-    )
-    .unwrap();
+    );
     match out {
         Outcome::Question(q) => {
             assert!(q.contains("black"), "{q}");
@@ -173,22 +160,13 @@ fn a_second_disagreement_becomes_a_question_not_a_guess() {
         }
         other => panic!("expected a question, got {other:?}"),
     }
-    assert_eq!(b.requests().len(), 2, "one re-ask, no more");
+    assert_eq!(reqs.len(), 2, "one re-ask, no more");
 }
 
 #[test]
 fn an_object_the_map_lacks_is_refused_after_the_reask() {
-    let map = flat_a();
-    let robot = SimRobot::new(map.clone());
     let piano = "objects: [(piano, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\n";
-    let b = Scripted::new(&[piano, piano]);
-    let out = plan_instruction(
-        &b,
-        &Prompts::builtin(),
-        "go to the piano",
-        &v2(&map, &robot),
-    )
-    .unwrap();
+    let (out, _) = plan_scripted(&[piano, piano], "go to the piano");
     match out {
         Outcome::Refusal(r) => assert!(r.contains("piano") && r.contains("sofa"), "{r}"),
         other => panic!("expected a refusal, got {other:?}"),
@@ -197,19 +175,10 @@ fn an_object_the_map_lacks_is_refused_after_the_reask() {
 
 #[test]
 fn a_map_error_in_the_dry_run_is_asked_about() {
-    let map = flat_a();
-    let robot = SimRobot::new(map.clone());
     // flat-a has two sofas: a 7th does not exist, whatever the model says twice.
     let seventh =
         "objects: [(sofa, 7, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{ordinal: 7}));\n";
-    let b = Scripted::new(&[seventh, seventh]);
-    let out = plan_instruction(
-        &b,
-        &Prompts::builtin(),
-        "go to the seventh sofa",
-        &v2(&map, &robot),
-    )
-    .unwrap();
+    let (out, _) = plan_scripted(&[seventh, seventh], "go to the seventh sofa");
     match out {
         Outcome::Question(q) => assert!(q.contains("sofa"), "{q}"),
         other => panic!("expected a question, got {other:?}"),
