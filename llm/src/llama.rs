@@ -513,7 +513,8 @@ fn choose_slot(slots: &[Slot], tokens: &[LlamaToken]) -> (usize, usize) {
 }
 
 /// The sampler chain of a request, and for a Lark grammar a second matcher that follows
-/// the sampled tokens to find the tokens the grammar forces (fast-forward).
+/// the sampled tokens: to check that the grammar still holds them, and to find the
+/// tokens the grammar forces (fast-forward).
 struct Sampling {
     chain: LlamaSampler,
     /// A clone of the Lark matcher that follows every token the chain samples. llama-cpp-2's

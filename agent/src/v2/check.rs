@@ -53,7 +53,8 @@ pub struct Finding {
 
 /// A form of the first answer that its re-ask's grammar bars, leaving the model every
 /// other choice (measured: a re-ask that only says what was wrong mended 4 of 15
-/// held-out v2 tasks, and of the 11 that became questions most wrote the wrong form again).
+/// re-asked held-out v2 tasks; a constraint that requires content instead made the
+/// default model loop).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Bar {
     /// Picks of this map label (and its synonyms) select on no colour the person did not
