@@ -104,7 +104,6 @@ fn a_disagreement_gets_one_targeted_reask() {
     let p = out.plan().expect("a plan after the re-ask");
     assert_eq!(p.source, PlanSource::Llm { repairs: 1 });
     assert_eq!(p.timing.llm_calls, 2);
-
     assert_eq!(reqs.len(), 2);
     let reask = reqs[1].messages.last().unwrap();
     assert_eq!(reask.role, Role::User);
@@ -132,7 +131,6 @@ fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
         "take me to the sofa, the black one",
     );
     assert!(out.plan().is_some(), "{out:?}");
-
     assert_eq!(reqs.len(), 2);
     // The re-ask's grammars are the first request's less what the finding bars (which
     // colours: `agent::v2`'s unit test `a_reask_bars_the_unsaid_colours_of_the_label_a_finding_names`).

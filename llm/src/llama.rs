@@ -744,7 +744,6 @@ impl Worker<'_> {
             chain: mut sampler,
             mut follower,
         } = self.sampler(req)?;
-        let fast_forward = self.cfg.fast_forward;
 
         let max_new = (req.max_tokens as usize).min(n_ctx - tokens.len());
 
@@ -852,7 +851,7 @@ impl Worker<'_> {
                         reason: why.to_string(),
                     });
                 }
-                if fast_forward {
+                if self.cfg.fast_forward {
                     let room = (max_new - n_gen).min(n_batch.saturating_sub(1));
                     let bytes = m.compute_ff_bytes();
                     if !bytes.is_empty() {

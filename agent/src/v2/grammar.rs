@@ -430,23 +430,29 @@ struct PickGroup {
     regions: Option<Vec<String>>,
 }
 
+/// The list of the group holding `name` in `groups` ([`Vocabulary::colours_of`],
+/// [`Vocabulary::regions_of`]): `None` when there are no groups or none holds it.
+pub(crate) fn group_list(
+    groups: Option<&[(Vec<String>, Vec<String>)]>,
+    name: &str,
+) -> Option<Vec<String>> {
+    groups?
+        .iter()
+        .find(|(names, _)| names.iter().any(|n| n == name))
+        .map(|(_, list)| list.clone())
+}
+
 /// The pick groups of `vocab` ([`Vocabulary::colours_of`] and [`Vocabulary::regions_of`]
 /// joined, the region lists cut to the region keys): `None` when neither narrows a name.
 fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
     if vocab.colours_of.is_none() && vocab.regions_of.is_none() {
         return None;
     }
-    let lookup = |of: &Option<Vec<(Vec<String>, Vec<String>)>>, name: &String| {
-        of.as_ref()?
-            .iter()
-            .find(|(names, _)| names.contains(name))
-            .map(|(_, list)| list.clone())
-    };
     let keys = region_keys(vocab);
     let mut groups: Vec<PickGroup> = Vec::new();
     for name in &vocab.names {
-        let colours = lookup(&vocab.colours_of, name);
-        let regions = lookup(&vocab.regions_of, name).map(|mut r| {
+        let colours = group_list(vocab.colours_of.as_deref(), name);
+        let regions = group_list(vocab.regions_of.as_deref(), name).map(|mut r| {
             r.retain(|x| keys.contains(x));
             r
         });

@@ -285,16 +285,9 @@ fn reask_vocabulary(
     };
     let mut v = vocab.clone();
     v.colours_of = Some(name_groups(map, |label| {
-        let first = grammar::label_names(label.to_string());
-        let mut list = vocab
-            .colours_of
-            .as_ref()
-            .and_then(|groups| {
-                groups
-                    .iter()
-                    .find(|(names, _)| first.iter().any(|n| names.contains(n)))
-                    .map(|(_, l)| l.clone())
-            })
+        let mut list = grammar::label_names(label.to_string())
+            .iter()
+            .find_map(|n| grammar::group_list(vocab.colours_of.as_deref(), n))
             .unwrap_or_else(|| vocab.colours.clone());
         if barred.contains(&label) {
             list.retain(|c| said(c) && !elsewhere(c, label));
