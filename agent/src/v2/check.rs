@@ -300,11 +300,7 @@ fn accounted_for(
 /// The colours the instruction says of a map object, with that object's label ("the
 /// white chair": white, chair), as [`noun_after`] reads them (colours in their canonical
 /// spelling: grey as gray).
-pub(crate) fn colours_said_of(
-    map: &IvlMap,
-    instruction: &str,
-    pose: Pose,
-) -> Vec<(String, String)> {
+pub(crate) fn colour_nouns(map: &IvlMap, instruction: &str, pose: Pose) -> Vec<(String, String)> {
     let w = words(instruction);
     (0..w.len())
         .filter(|&i| is_colour_word(&w[i]))

@@ -273,7 +273,7 @@ fn reask_vocabulary(
         return None;
     }
     let said = check::colour_said(instruction, known);
-    let said_of = check::colours_said_of(map, instruction, pose);
+    let said_of = check::colour_nouns(map, instruction, pose);
     // Said of objects, but never of one of `label`.
     let elsewhere = |c: &str, label: &str| {
         let of: Vec<&String> = said_of
