@@ -278,6 +278,8 @@ mod tests {
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let unsaid = super::super::check::unsaid_sizes(&e.instruction, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
+            let unsaid = super::super::check::unsaid_far_ends(&e.instruction, &a.plan);
+            assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let in_chat = e.history.is_some();
             let unsaid = super::super::check::unsaid_ordinals(&e.instruction, in_chat, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
