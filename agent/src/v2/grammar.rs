@@ -34,6 +34,10 @@ pub struct Vocabulary {
     pub no_sizes: bool,
     /// Offer no `far_to_near` order (farthest first).
     pub no_far_end: bool,
+    /// Names whose picks must select on a colour (`colour:`, one of the name's colours
+    /// in [`Vocabulary::colours_of`]): a re-ask after a said colour the plan dropped
+    /// ([`check::Bar::ColourDropped`](super::check::Bar::ColourDropped)).
+    pub colour_required: Vec<String>,
     /// The colours a pick of each name may select on (`colour` and `not_colour`), as
     /// groups of names sharing one colour list (`None`: every name any of `colours`).
     /// A group with no colours picks that name without a colour key.
@@ -124,6 +128,7 @@ impl Vocabulary {
             no_directions: false,
             no_sizes: false,
             no_far_end: false,
+            colour_required: Vec::new(),
             colours_of: None,
             region_keys: None,
             regions_of: (!map.regions.is_empty()).then_some(regions_of),
@@ -387,9 +392,16 @@ struct SelKeys<'a> {
     positive: bool,
     negative: bool,
     not_from_end: bool,
+    /// The map ends only after a `colour:` key.
+    colour_required: bool,
 }
 
 impl SelKeys<'_> {
+    /// Whether the map may end in `s`.
+    fn may_end(&self, s: SelState) -> bool {
+        !self.colour_required || self.colour.is_none() || s.written & KEY_COLOUR != 0
+    }
+
     /// The keys that may come next in `s`, each as its text and the state after it.
     fn next(&self, s: SelState) -> Vec<(String, SelState)> {
         let after = |key: u8, pending: Pending| SelState {
@@ -416,7 +428,10 @@ impl SelKeys<'_> {
         }
         if let Some(c) = self.colour {
             for (key, name) in [(KEY_COLOUR, "colour"), (KEY_NOT_COLOUR, "not_colour")] {
-                if open(key) {
+                // A required colour is the one said: none of them is excluded (measured:
+                // with both on offer the default model wrote `not_colour: "yellow", ...,
+                // colour: "yellow"` for "the yellow table furthest from you").
+                if open(key) && !(self.colour_required && key == KEY_NOT_COLOUR) {
                     out.push((format!("\"{name}: \" {c}"), after(key, s.pending)));
                 }
             }
@@ -473,6 +488,7 @@ fn selection_rules(
     region: Option<&str>,
     vocab: &Vocabulary,
     not_from_end: bool,
+    colour_required: bool,
 ) {
     let (positive, negative) = ordinal_signs(vocab);
     let keys = SelKeys {
@@ -481,6 +497,7 @@ fn selection_rules(
         positive,
         negative,
         not_from_end,
+        colour_required,
     };
     let name = |s: SelState| {
         let pending = match s.pending {
@@ -508,12 +525,16 @@ fn selection_rules(
         let alternatives: Vec<String> = keys
             .next(s)
             .into_iter()
-            .map(|(key, after)| {
-                if keys.next(after).is_empty() {
-                    key
-                } else {
+            .filter_map(|(key, after)| {
+                let more = !keys.next(after).is_empty();
+                if more {
                     todo.push(after);
-                    format!("{key} (\", \" {})?", name(after))
+                }
+                match (more, keys.may_end(after)) {
+                    (false, false) => None,
+                    (false, true) => Some(key),
+                    (true, true) => Some(format!("{key} (\", \" {})?", name(after))),
+                    (true, false) => Some(format!("{key} \", \" {}", name(after))),
                 }
             })
             .collect();
@@ -528,6 +549,8 @@ struct PickGroup {
     names: Vec<String>,
     colours: Option<Vec<String>>,
     regions: Option<Vec<String>>,
+    /// Its picks must select on a colour ([`Vocabulary::colour_required`]).
+    colour_required: bool,
 }
 
 /// The list of the group holding `name` in `groups` ([`Vocabulary::colours_of`],
@@ -545,7 +568,8 @@ pub(crate) fn group_list(
 /// The pick groups of `vocab` ([`Vocabulary::colours_of`] and [`Vocabulary::regions_of`]
 /// joined, the region lists cut to the region keys): `None` when neither narrows a name.
 fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
-    if vocab.colours_of.is_none() && vocab.regions_of.is_none() {
+    if vocab.colours_of.is_none() && vocab.regions_of.is_none() && vocab.colour_required.is_empty()
+    {
         return None;
     }
     let keys = region_keys(vocab);
@@ -556,15 +580,16 @@ fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
             r.retain(|x| keys.contains(x));
             r
         });
-        match groups
-            .iter_mut()
-            .find(|g| g.colours == colours && g.regions == regions)
-        {
+        let colour_required = vocab.colour_required.contains(name);
+        match groups.iter_mut().find(|g| {
+            g.colours == colours && g.regions == regions && g.colour_required == colour_required
+        }) {
             Some(g) => g.names.push(name.clone()),
             None => groups.push(PickGroup {
                 names: vec![name.clone()],
                 colours,
                 regions,
+                colour_required,
             }),
         }
     }
@@ -632,12 +657,16 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
         Some(groups) if !groups.is_empty() => {
             let mut picks = Vec::new();
             for (g, group) in groups.iter().enumerate() {
+                let sel = if group.colour_required
+                    && group.colours.as_ref().is_none_or(|c| !c.is_empty())
+                {
+                    format!("\", \" selmap{g}")
+                } else {
+                    format!("(\", \" selmap{g})?")
+                };
                 w.rule(
                     &format!("pick{g}"),
-                    &format!(
-                        "{get} ({}) (\", \" selmap{g})? \")\"",
-                        alt(&group.names, true)
-                    ),
+                    &format!("{get} ({}) {sel} \")\"", alt(&group.names, true)),
                 );
                 picks.push(format!("pick{g}"));
             }
@@ -711,6 +740,7 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
         all_regions,
         vocab,
         !not_from_end.is_empty(),
+        false,
     );
     for (g, group) in groups.iter().flatten().enumerate() {
         let colours = match &group.colours {
@@ -736,6 +766,7 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
             regions.as_deref(),
             vocab,
             !not_from_end.is_empty(),
+            group.colour_required,
         );
     }
     let (positive, negative) = ordinal_signs(vocab);
@@ -1010,6 +1041,35 @@ pub(crate) mod tests {
                 .count()
         };
         assert_eq!(count(&g, " ::= "), count(&lark, ": "));
+    }
+
+    #[test]
+    fn a_required_colour_must_be_written_in_any_order() {
+        let mut v = vocab();
+        v.colours_of = Some(vec![(vec!["chair".into()], vec!["black".into()])]);
+        v.colour_required = vec!["chair".into()];
+        let lark = answer_lark(&v);
+        let answer =
+            |pick: &str| format!("objects: [(chair, 2, black)]\nplan:\nmove_to_object({pick});");
+        assert_offers(
+            &lark,
+            answer,
+            &[
+                "get_obj(\"chair\", #{colour: \"black\"})",
+                "get_obj(\"chair\", #{ordinal: 2, order: \"north_to_south\", colour: \"black\"})",
+                "get_obj(\"sofa\")",
+                "get_obj(\"sofa\", #{colour: \"red\", near: get_obj(\"chair\", #{colour: \"black\"})})",
+            ],
+            &[
+                "get_obj(\"chair\")",
+                "get_obj(\"chair\", #{ordinal: 2})",
+                "get_obj(\"chair\", #{ordinal: 2, not_colour: \"black\"})",
+                "get_obj(\"chair\", #{colour: \"black\", not_colour: \"black\"})",
+                "get_obj(\"chair\", #{colour: \"red\"})",
+            ],
+        );
+        let g = answer_grammar(&v);
+        assert!(undefined_rules(&g).is_empty(), "{:?}", undefined_rules(&g));
     }
 
     #[test]

@@ -264,14 +264,15 @@ fn reask_vocabulary(
     findings: &[Finding],
     pose: Pose,
 ) -> Option<Vocabulary> {
-    let barred: Vec<&str> = findings
-        .iter()
-        .filter_map(|f| f.bar.as_ref())
-        .map(|b| match b {
-            check::Bar::UnsaidColours { label } => label.as_str(),
-        })
-        .collect();
-    if barred.is_empty() {
+    let mut barred: Vec<&str> = Vec::new();
+    let mut required: Vec<&str> = Vec::new();
+    for b in findings.iter().filter_map(|f| f.bar.as_ref()) {
+        match b {
+            check::Bar::UnsaidColours { label } => barred.push(label),
+            check::Bar::ColourDropped { label } => required.push(label),
+        }
+    }
+    if barred.is_empty() && required.is_empty() {
         return None;
     }
     let said = check::colour_said(instruction, known);
@@ -291,11 +292,21 @@ fn reask_vocabulary(
             .iter()
             .find_map(|n| grammar::group_list(vocab.colours_of.as_deref(), n))
             .unwrap_or_else(|| vocab.colours.clone());
-        if barred.contains(&label) {
+        if required.contains(&label) {
+            list.retain(|c| {
+                said_of
+                    .iter()
+                    .any(|(x, l)| l == label && check::same_colour(Some(x), c))
+            });
+        } else if barred.contains(&label) {
             list.retain(|c| said(c) && !elsewhere(c, label));
         }
         list
     }));
+    for label in required {
+        v.colour_required
+            .extend(grammar::label_names(label.to_string()));
+    }
     Some(v)
 }
 
@@ -519,23 +530,21 @@ mod tests {
         assert_eq!(v.colours_of, None);
     }
 
+    /// The checks' findings on `answer` to `instruction`, a first answer on `m`.
+    fn first_findings(m: &map_core::IvlMap, instruction: &str, answer: &str) -> Vec<Finding> {
+        let a = parse_answer(answer).unwrap();
+        check_answer(m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[])
+    }
+
     #[test]
     fn a_reask_bars_the_unsaid_colours_of_the_label_a_finding_names() {
         let m = map();
         let v = Vocabulary::for_map(&m);
         let instruction = "go to the chair, the yellow one, then the grey couch";
-        let answer = parse_answer(
-            "objects: [(chair, None, red), (couch, None, grey)]\nplan:\nmove_to_object(get_obj(\"chair\", #{colour: \"red\"}));\nmove_to_object(get_obj(\"couch\", #{colour: \"grey\"}));",
-        )
-        .unwrap();
-        let f = check_answer(
+        let f = first_findings(
             &m,
             instruction,
-            &answer.tuples,
-            &answer.plan,
-            m.start_pose,
-            &[],
-            &[],
+            "objects: [(chair, None, red), (couch, None, grey)]\nplan:\nmove_to_object(get_obj(\"chair\", #{colour: \"red\"}));\nmove_to_object(get_obj(\"couch\", #{colour: \"grey\"}));",
         );
         assert!(f.iter().any(|x| x.bar.is_some()), "{f:?}");
         let r = reask_vocabulary(&v, &m, instruction, &[], &f, m.start_pose).unwrap();
@@ -582,6 +591,49 @@ mod tests {
             &pick(r#""chair", #{colour: "red"}"#)
         )
         .is_ok());
+    }
+
+    #[test]
+    fn a_reask_after_a_dropped_colour_requires_it_on_that_label() {
+        // Qwen 1.5B on people.nav's fa8 (dev): "the second black chair counting from the
+        // north" as `#{ordinal: 2, order: "north_to_south"}`, first answer and re-ask.
+        let m = map();
+        let v = Vocabulary::for_map(&m);
+        let instruction = "go to the sink, then the second black chair counting from the north";
+        let f = first_findings(
+            &m,
+            instruction,
+            "objects: [(chair, 2, black, north_to_south)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, order: \"north_to_south\"}));",
+        );
+        assert!(
+            f.iter().any(|x| x.bar
+                == Some(check::Bar::ColourDropped {
+                    label: "chair".into()
+                })),
+            "{f:?}"
+        );
+        let r = reask_vocabulary(&v, &m, instruction, &[], &f, m.start_pose).unwrap();
+        assert!(r.colour_required.contains(&"chair".to_string()), "{r:?}");
+        let lark = answer_lark(&r);
+        let pick = |sel: &str| {
+            format!("objects: [(chair, 2, black)]\nplan:\nmove_to_object(get_obj({sel}));")
+        };
+        for ok in [
+            r#""chair", #{ordinal: 2, order: "north_to_south", colour: "black"}"#,
+            r#""sofa""#,
+        ] {
+            grammar::tests::lark_accepts(&lark, &pick(ok)).unwrap_or_else(|e| panic!("{ok}: {e}"));
+        }
+        for barred in [
+            r#""chair", #{ordinal: 2, order: "north_to_south"}"#,
+            r#""chair", #{colour: "red"}"#,
+            r#""chair""#,
+        ] {
+            assert!(
+                grammar::tests::lark_accepts(&lark, &pick(barred)).is_err(),
+                "{barred}"
+            );
+        }
     }
 
     #[test]
