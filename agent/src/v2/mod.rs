@@ -255,7 +255,9 @@ fn colours_said_of(map: &map_core::IvlMap, instruction: &str) -> Vec<(Vec<String
 /// A barred label keeps the colours the person said, less those said only of another
 /// object ("a white chair" for a stool): measured on held-out v2's hd07 ("third stool
 /// please, then a white chair"), with every said colour left on offer the re-ask moved
-/// the chair's white onto the stool.
+/// the chair's white onto the stool. A label whose said colour was dropped
+/// ([`check::Bar::ColourDropped`]) must select on one of the colours said before its
+/// name ([`check::colour_nouns`]); that bar wins where a label has both.
 fn reask_vocabulary(
     vocab: &Vocabulary,
     map: &map_core::IvlMap,
