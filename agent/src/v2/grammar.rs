@@ -392,14 +392,14 @@ struct SelKeys<'a> {
     positive: bool,
     negative: bool,
     not_from_end: bool,
-    /// The map ends only after a `colour:` key.
+    /// The map ends only after a `colour:` key (only with `colour`).
     colour_required: bool,
 }
 
 impl SelKeys<'_> {
     /// Whether the map may end in `s`.
     fn may_end(&self, s: SelState) -> bool {
-        !self.colour_required || self.colour.is_none() || s.written & KEY_COLOUR != 0
+        !self.colour_required || s.written & KEY_COLOUR != 0
     }
 
     /// The keys that may come next in `s`, each as its text and the state after it.
@@ -549,7 +549,8 @@ struct PickGroup {
     names: Vec<String>,
     colours: Option<Vec<String>>,
     regions: Option<Vec<String>>,
-    /// Its picks must select on a colour ([`Vocabulary::colour_required`]).
+    /// Its picks must select on a colour ([`Vocabulary::colour_required`]); only where
+    /// it has a colour to offer.
     colour_required: bool,
 }
 
@@ -580,7 +581,11 @@ fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
             r.retain(|x| keys.contains(x));
             r
         });
-        let colour_required = vocab.colour_required.contains(name);
+        // Required only where the pick has a colour key to write.
+        let colour_required = vocab.colour_required.contains(name)
+            && colours
+                .as_ref()
+                .map_or(!vocab.colours.is_empty(), |c| !c.is_empty());
         match groups.iter_mut().find(|g| {
             g.colours == colours && g.regions == regions && g.colour_required == colour_required
         }) {
@@ -657,9 +662,7 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
         Some(groups) if !groups.is_empty() => {
             let mut picks = Vec::new();
             for (g, group) in groups.iter().enumerate() {
-                let sel = if group.colour_required
-                    && group.colours.as_ref().is_none_or(|c| !c.is_empty())
-                {
+                let sel = if group.colour_required {
                     format!("\", \" selmap{g}")
                 } else {
                     format!("(\", \" selmap{g})?")
@@ -921,7 +924,12 @@ pub(crate) mod tests {
 
     /// Asserts that `lark` accepts `answer(x)` for each `x` of `ok` and rejects it for each
     /// of `barred`.
-    fn assert_offers(lark: &str, answer: impl Fn(&str) -> String, ok: &[&str], barred: &[&str]) {
+    pub(crate) fn assert_offers(
+        lark: &str,
+        answer: impl Fn(&str) -> String,
+        ok: &[&str],
+        barred: &[&str],
+    ) {
         for x in ok {
             lark_accepts(lark, &answer(x)).unwrap_or_else(|e| panic!("{x}: {e}"));
         }
