@@ -653,7 +653,14 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
     }
     w.rule("letstmt", "\"let \" var \" = \" pick \";\"");
     w.rule("step", &format!("({}) \";\"", steps.join(" | ")));
-    let var = w.pattern("[a-z] [a-z0-9_]{0,15}", "[a-z][a-z0-9_]{0,15}");
+    // A variable is never named like a library call (`get_...`): measured on
+    // people.nav (dev) ob4, with any identifier on offer the default model wrote
+    // `get_instance_by_` where an object goes, an unbound variable. Without that
+    // prefix, what starts `get_` there is a pick.
+    let var = w.pattern(
+        "([a-fh-z] [a-z0-9_]{0,15} | \"g\" ([a-df-z0-9_] [a-z0-9_]{0,14} | \"e\" ([a-su-z0-9_] [a-z0-9_]{0,13} | \"t\" ([a-z0-9] [a-z0-9_]{0,12})?)?)?)",
+        "[a-fh-z][a-z0-9_]{0,15}|g([a-df-z0-9_][a-z0-9_]{0,14}|e([a-su-z0-9_][a-z0-9_]{0,13}|t([a-z0-9][a-z0-9_]{0,12})?)?)?",
+    );
     w.rule("var", &var);
     let get = q(&format!("{PICK_FUNCTION}("));
     let groups = pick_groups(vocab);
@@ -1013,6 +1020,40 @@ pub(crate) mod tests {
             &["ordinal: 3"],
             &["ordinal: 1", "ordinal: -2"],
         );
+    }
+
+    #[test]
+    fn a_variable_is_never_named_like_a_call() {
+        let lark = answer_lark(&vocab());
+        let answer = |var: &str| {
+            format!("objects: [(chair, None, None)]\nplan:\nlet {var} = get_obj(\"chair\");\nmove_to_object({var});")
+        };
+        assert_offers(
+            &lark,
+            answer,
+            &[
+                "chair",
+                "g",
+                "ge",
+                "get",
+                "gate",
+                "gel",
+                "getter",
+                "target",
+                "the_chair2",
+            ],
+            &["get_", "get_instance_by_", "get_obj", "Chair", "2nd"],
+        );
+        // Where an object goes, what starts `get_` is a pick.
+        let used =
+            |obj: &str| format!("objects: [(chair, None, None)]\nplan:\nmove_to_object({obj});");
+        assert_offers(
+            &lark,
+            used,
+            &["get_obj(\"chair\")", "chair"],
+            &["get_instance_by_id", "get_chair"],
+        );
+        assert!(undefined_rules(&answer_grammar(&vocab())).is_empty());
     }
 
     #[test]
