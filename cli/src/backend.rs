@@ -38,6 +38,9 @@ pub struct BackendChoice {
     pub record: Option<PathBuf>,
     /// llama: CPU threads (default 2).
     pub threads: Option<u32>,
+    /// llama: flash attention on (`Some(true)`), off (`Some(false)`, the command line's
+    /// default) or llama.cpp's own choice (`None`).
+    pub flash_attention: Option<bool>,
     /// openai: send each request's GBNF grammar as the `grammar` field (a llama-server
     /// extension; other servers may ignore or refuse it). Off: the grammar is not sent.
     pub send_grammar: bool,
@@ -84,6 +87,7 @@ pub fn open_backend(choice: &BackendChoice) -> Result<Box<dyn LlmBackend>, LlmEr
             if let Some(t) = choice.threads {
                 cfg.threads = t.max(1);
             }
+            cfg.flash_attention = choice.flash_attention;
             cfg.prompt_cache_dir.clone_from(&choice.prompt_cache);
             Box::new(LlamaCppBackend::new(cfg)?)
         }
