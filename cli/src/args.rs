@@ -225,9 +225,10 @@ pub(crate) struct ModelArgs {
     /// llama: CPU threads.
     #[arg(long)]
     pub(crate) threads: Option<u32>,
-    /// llama: llama.cpp's flash attention kernel (default off: on this project's 2-thread
-    /// CPU runs, off generates about 1.2x faster after a long cached prompt).
-    #[arg(long, value_enum, value_name = "WHEN", default_value = "off")]
+    /// llama: llama.cpp's flash attention kernel (default auto: llama.cpp's choice, on for
+    /// a CPU). Off generates about 1.2x faster after a long cached prompt, but a greedy
+    /// answer may then depend on what the prompt cache held.
+    #[arg(long, value_enum, value_name = "WHEN", default_value = "auto")]
     pub(crate) flash_attention: FlashAttention,
     /// llama: folder of the prompt cache on disk (snapshots of long prompt prefixes read
     /// back by later runs; default ~/.cache/ivlmap/prompt-cache).

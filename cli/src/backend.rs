@@ -38,8 +38,8 @@ pub struct BackendChoice {
     pub record: Option<PathBuf>,
     /// llama: CPU threads (default 2).
     pub threads: Option<u32>,
-    /// llama: flash attention on (`Some(true)`), off (`Some(false)`, the command line's
-    /// default) or llama.cpp's own choice (`None`).
+    /// llama: flash attention on (`Some(true)`), off (`Some(false)`) or llama.cpp's own
+    /// choice (`None`, the default).
     pub flash_attention: Option<bool>,
     /// openai: send each request's GBNF grammar as the `grammar` field (a llama-server
     /// extension; other servers may ignore or refuse it). Off: the grammar is not sent.
