@@ -8,7 +8,8 @@
 //! little-endian `i32`, read at start-up to choose an entry without loading it). The model
 //! key is the GGUF's file name, size and modification time, so a changed model never
 //! reads another's snapshot, followed by the evaluation's settings (threads, batch
-//! size): llama.cpp's sums run in another order with another thread count, and measured
+//! size, and flash attention when it is set, whose values llama.cpp lays out otherwise;
+//! `snapshot_settings` in `llama.rs`): llama.cpp's sums run in another order with another thread count, and measured
 //! (Qwen 1.5B, a people.nav instruction) a prefix evaluated on 1 thread and read back by
 //! a 2-thread run changed a greedy answer (`#{colour: "black"}` where 2 threads from
 //! scratch write `#{ordinal: 1, colour: "black"}`), so a snapshot is read back only
