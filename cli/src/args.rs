@@ -198,7 +198,7 @@ impl BackendArgs {
 }
 
 /// When llama.cpp uses its flash attention kernel (`--flash-attention`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub(crate) enum FlashAttention {
     On,
     Off,

@@ -6,16 +6,16 @@
 //! Layout: `<dir>/<model key>/<n>.kv` (llama.cpp's `llama_state_seq_save_file`: the
 //! sequence's keys and values, with its tokens) beside `<n>.tokens` (the same tokens as
 //! little-endian `i32`, read at start-up to choose an entry without loading it). The model
-//! key is the GGUF's file name, size and modification time, so a changed model never
-//! reads another's snapshot, followed by the evaluation's settings (threads, batch
-//! size, and flash attention when it is set, whose values llama.cpp lays out otherwise;
-//! `snapshot_settings` in `llama.rs`): llama.cpp's sums run in another order with another thread count, and measured
-//! (Qwen 1.5B, a people.nav instruction) a prefix evaluated on 1 thread and read back by
-//! a 2-thread run changed a greedy answer (`#{colour: "black"}` where 2 threads from
-//! scratch write `#{ordinal: 1, colour: "black"}`), so a snapshot is read back only
-//! under the settings that wrote it. An entry counts only when both files are there; a
-//! snapshot llama.cpp refuses to load (another llama.cpp version, a truncated file) is
-//! deleted.
+//! key is the GGUF's file name, size and modification time, so a changed model never reads
+//! another's snapshot, followed by the evaluation's settings (threads, batch size, and
+//! flash attention when it is set, whose values llama.cpp lays out otherwise;
+//! `snapshot_settings` in `llama.rs`): llama.cpp's sums run in another order with another
+//! thread count, and measured (Qwen 1.5B, a people.nav instruction) a prefix evaluated on 1
+//! thread and read back by a 2-thread run changed a greedy answer (`#{colour: "black"}`
+//! where 2 threads from scratch write `#{ordinal: 1, colour: "black"}`), so a snapshot is
+//! read back only under the settings that wrote it. An entry counts only when both files
+//! are there; a snapshot llama.cpp refuses to load (another llama.cpp version, a truncated
+//! file) is deleted.
 //!
 //! What is saved: when a request reuses at least [`MIN_TOKENS`] tokens of a slot (the
 //! prefix two requests shared) and no entry already covers that prefix, the slot's
