@@ -172,10 +172,10 @@ fn map_names(map: &IvlMap) -> String {
 }
 
 /// The objects line against the map and the plan: an object the person named (a word of
-/// the instruction) that the map lacks, a colour the map has no such object in, and an
-/// object the plan never goes to or uses. The line's ordinals and colours are the
-/// model's notes: the words check ([`check_words`]) compares the plan itself with what
-/// the person said.
+/// the instruction) that the map lacks, a said colour the map has no such object in,
+/// and a named object the plan never goes to or uses ([`names_label`]). The line's
+/// ordinals, and its objects and colours the person did not say, are the model's notes:
+/// the words check ([`check_words`]) compares the plan itself with what the person said.
 fn check_tuples(
     map: &IvlMap,
     instruction: &str,
@@ -1943,7 +1943,7 @@ pub(crate) mod tests {
         );
         assert!(f.is_empty(), "{f:?}");
         // Said, the same colour and room are findings; so is a synonym or a typo of a
-        // name ("couch", "tabel") the plan leaves out.
+        // name ("couch", "sofaa") the plan leaves out.
         for (instruction, tuple, kind) in [
             (
                 "first the biggest purple table, then the sink, and then back to where you started",
