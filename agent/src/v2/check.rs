@@ -58,13 +58,13 @@ pub struct Finding {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Bar {
     /// Picks of this map label (and its synonyms) select on no colour the person did not
-    /// say (`colour` and `not_colour`; [`colour_said`]).
+    /// say (`colour` and `not_colour`; `check::colour_said`).
     UnsaidColours {
         /// The map label.
         label: String,
     },
     /// Picks of this map label select on a colour, one the person said before that
-    /// label's name ("the second black chair"; [`colour_nouns`]): the first answer
+    /// label's name ("the second black chair"; `check::colour_nouns`): the first answer
     /// dropped it. Unlike the other bar this one requires a key, so it is given only
     /// where the re-ask that described the finding had never mended it (measured: six
     /// dev tasks, none mended).
