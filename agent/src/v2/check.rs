@@ -173,7 +173,7 @@ fn map_names(map: &IvlMap) -> String {
 
 /// The objects line against the map and the plan: an object the person named (a word of
 /// the instruction) that the map lacks, a said colour the map has no such object in,
-/// and a named object the plan never goes to or uses ([`names_label`]). The line's
+/// and a named object the plan never goes to or uses ([`named_labels`]). The line's
 /// ordinals, and its objects and colours the person did not say, are the model's notes:
 /// the words check ([`check_words`]) compares the plan itself with what the person said.
 fn check_tuples(
@@ -218,6 +218,7 @@ fn check_tuples(
     let said_words = format!(" {said} ");
     let known = colours_of(map, refs);
     let colour_is_said = colour_said(instruction, &known);
+    let named = named_labels(map, &w, pose);
     for t in tuples {
         // A colour is not an object ("the sofa, the red one" listed as (red, ...)).
         if is_colour_word(&t.object) {
@@ -253,7 +254,7 @@ fn check_tuples(
         // what runs, and the words checks judge it. Measured on the dev sets: these two
         // findings alone sent right plans (people.nav's pp-hc7, held-out v2's hf09
         // re-ask) to a re-ask or a question.
-        if !literal && !names_label(map, &w, &label, pose) {
+        if !literal && !named.contains(&label) {
             continue;
         }
         let region = is_region(map, &label);
@@ -292,23 +293,26 @@ fn check_tuples(
     out
 }
 
-/// Whether a word or two of the instruction `w` name `label`: the name itself, a synonym
-/// ("couch" for the sofa), a compound ("armchair") or, for a word of four letters or
-/// more that is not a colour, a typo ("tabel"). Shorter words are read exactly: "to" is
-/// one edit from "tv", "red" from "bed".
-fn names_label(map: &IvlMap, w: &[String], label: &str, pose: Pose) -> bool {
-    let means = |s: &str, typo: bool| {
-        let l = if typo {
-            label_of_typed(map, s, pose)
+/// The labels (and regions) a word or two of the instruction `w` name: the name itself,
+/// a synonym ("couch" for the sofa), a compound ("armchair") or, for a word of four
+/// letters or more that is not a colour, a typo ("tabel"). Shorter words are read
+/// exactly: "to" is one edit from "tv", "red" from "bed". Read once per answer, not per
+/// tuple.
+fn named_labels(map: &IvlMap, w: &[String], pose: Pose) -> Vec<String> {
+    let single = w.iter().filter(|x| !is_colour_word(x)).filter_map(|x| {
+        if x.chars().count() >= 4 {
+            label_of_typed(map, x, pose)
         } else {
-            label_of(map, s, pose)
-        };
-        l.as_deref() == Some(label)
-    };
-    let single = w
-        .iter()
-        .any(|x| !is_colour_word(x) && means(x, x.chars().count() >= 4));
-    single || w.windows(2).any(|p| means(&p.join(" "), false))
+            label_of(map, x, pose)
+        }
+    });
+    let pairs = w
+        .windows(2)
+        .filter_map(|p| label_of(map, &p.join(" "), pose));
+    let mut out: Vec<String> = single.chain(pairs).collect();
+    out.sort();
+    out.dedup();
+    out
 }
 
 /// Whether the plan accounts for `label`: it names it (`used`), its dry run reached one
