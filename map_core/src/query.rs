@@ -262,6 +262,17 @@ pub enum QueryError {
         /// The excluded colour.
         colour: String,
     },
+    /// "The other chair" leaving out an instance that is no chair: `other_than` names
+    /// an instance of another kind than the selection's.
+    #[error("instance {id} is a {its}, not a {name}; only a {name} can be left out")]
+    OtherThanElsewhere {
+        /// The instance left out.
+        id: u32,
+        /// Its label.
+        its: String,
+        /// The selection's matched label.
+        name: String,
+    },
     /// "Between the two X" where not exactly two instances match.
     #[error("\"the two {what}\" names {count} here, not 2 (ids {})", .ids.iter().map(u32::to_string).collect::<Vec<_>>().join(", "))]
     NotExactlyTwo {

@@ -11,13 +11,15 @@
 //! | "the second to last chair", "the penultimate chair" | `ordinal: 2`, the reversed order (`far_to_near`), or `ordinal: -2` (n-th from the end) |
 //! | "the red sofa", "the sofa, the red one", "a red sofa" | `colour: "red"` |
 //! | "the table that isn't yellow" | `not_colour: "yellow"` |
+//! | "the other red chair" (after visiting red chair 9), "a different one" | `other_than: 9` |
 //! | "the plant in the lounge" | `region: "lounge"` |
 //! | "the biggest table", "the smallest plant" | `ordinal: 1`, `largest_to_smallest` / `smallest_to_largest` |
 //! | "the chair next to / nearest / by the table" | `near: <the table's id>` (distances from its footprint) |
 //! | "between the two yellow tables" | [`IvlMap::select_pair`]: exactly two must match |
 //!
 //! Filters apply first (name, region, colour, excluded colour, the anchor itself
-//! left out), then the order ranks what is left and the ordinal picks.
+//! left out, the instance `other_than` names left out), then the order ranks what is
+//! left and the ordinal picks.
 //!
 //! ```
 //! use map_core::select::Selection;
@@ -43,6 +45,9 @@
 //! // "the biggest table"
 //! let big = Selection::new("table").ordered("largest_to_smallest").unwrap();
 //! assert_eq!(map.select(&big, robot).unwrap().id, 4);
+//! // "now the other red chair", after red chair 2
+//! let other = Selection::new("chair").colour("red").other_than(2);
+//! assert_eq!(map.select(&other, robot).unwrap().id, 3);
 //! ```
 
 use serde::{Deserialize, Serialize};
@@ -83,6 +88,11 @@ pub struct Selection<A = u32> {
     /// footprint instead of from the robot, and the anchor itself is left out.
     #[serde(default = "Option::default", skip_serializing_if = "Option::is_none")]
     pub near: Option<A>,
+    /// An instance left out ("the other red chair", said after visiting one): the
+    /// same kind as the selection's name, or the selection is an error
+    /// ([`QueryError::OtherThanElsewhere`]); the ordinal counts what is left.
+    #[serde(default = "Option::default", skip_serializing_if = "Option::is_none")]
+    pub other_than: Option<A>,
 }
 
 impl<A> Default for Selection<A> {
@@ -95,6 +105,7 @@ impl<A> Default for Selection<A> {
             order: ObjectOrder::default(),
             region: None,
             near: None,
+            other_than: None,
         }
     }
 }
@@ -150,6 +161,13 @@ impl<A> Selection<A> {
     #[must_use]
     pub fn near(mut self, anchor: A) -> Self {
         self.near = Some(anchor);
+        self
+    }
+
+    /// Leaving out `instance` ("the other one").
+    #[must_use]
+    pub fn other_than(mut self, instance: A) -> Self {
+        self.other_than = Some(instance);
         self
     }
 }
@@ -267,6 +285,18 @@ impl IvlMap {
             ),
             None => None,
         };
+        if let Some(id) = sel.other_than {
+            let left_out = self
+                .instance_by_id(id)
+                .ok_or(QueryError::UnknownInstance { id })?;
+            if left_out.label != label {
+                return Err(QueryError::OtherThanElsewhere {
+                    id,
+                    its: left_out.label.clone(),
+                    name: label,
+                });
+            }
+        }
         let mut same: Vec<&Instance> = self
             .instances
             .iter()
@@ -340,6 +370,17 @@ impl IvlMap {
                 colour: given(sel.colour.as_deref()).unwrap_or_default().to_string(),
                 available,
             });
+        }
+        if let Some(id) = sel.other_than {
+            cands.retain(|i| i.id != id);
+            if cands.is_empty() {
+                // "the other red chair" where the one visited is the only red chair
+                return Err(QueryError::OrdinalPastCount {
+                    what: format!("other {}", coloured(plural(&label), sel)),
+                    count: 0,
+                    k: sel.ordinal.max(1),
+                });
+            }
         }
         let key = |i: &Instance| match (anchor, sel.order) {
             (Some(a), ObjectOrder::NearToFar) => footprint_distance(a, i),
@@ -535,6 +576,58 @@ mod tests {
     }
 
     #[test]
+    fn the_other_one_leaves_out_the_instance_named() {
+        let m = map();
+        // "now the other red chair", after red chair 11: chair 14
+        let other = Selection::new("chair").colour("red").other_than(11);
+        assert_eq!(pick(&m, &other), 14);
+        // after 14, the other red chair is 11 (the blue one is never a candidate)
+        let other = Selection::new("chair").colour("red").other_than(14);
+        assert_eq!(pick(&m, &other), 11);
+        // "another table" after table 1: the nearest of the rest, and the ordinal
+        // counts what is left ("the second other table")
+        assert_eq!(pick(&m, &Selection::new("table").other_than(1)), 2);
+        assert_eq!(pick(&m, &Selection::new("table").other_than(1).nth(2)), 3);
+        assert_eq!(pick(&m, &Selection::new("table").other_than(1).nth(-1)), 4);
+        // leaving out an instance the filters already left out changes nothing
+        assert_eq!(
+            pick(&m, &Selection::new("chair").colour("red").other_than(13)),
+            11
+        );
+        // the one visited is the only blue chair: an error that says so
+        let e = m
+            .select(
+                &Selection::new("chair").colour("blue").other_than(13),
+                ORIGIN,
+            )
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "there are 0 other blue chairs; asked for the 1st"
+        );
+        // an instance of another kind, or none at all: errors, never a silent pick
+        let e = m
+            .select(&Selection::new("chair").other_than(2), ORIGIN)
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "instance 2 is a table, not a chair; only a chair can be left out"
+        );
+        assert!(matches!(
+            m.select(&Selection::new("chair").other_than(99), ORIGIN),
+            Err(QueryError::UnknownInstance { id: 99 })
+        ));
+        // "between the two" with one left out: the two that remain
+        let [a, b] = m
+            .select_pair(
+                &Selection::new("table").not_colour("grey").other_than(2),
+                ORIGIN,
+            )
+            .unwrap();
+        assert_eq!((a.id, b.id), (1, 3));
+    }
+
+    #[test]
     fn biggest_and_smallest_rank_by_footprint_area() {
         let m = map();
         let big = Selection::new("table")
@@ -578,6 +671,8 @@ mod tests {
     fn selections_read_and_write_json_with_defaults() {
         let s: Selection = serde_json::from_str(r#"{"name": "chair", "near": 4}"#).unwrap();
         assert_eq!(s, Selection::new("chair").near(4));
+        let o: Selection = serde_json::from_str(r#"{"name": "chair", "other_than": 9}"#).unwrap();
+        assert_eq!(o, Selection::new("chair").other_than(9));
         let back: Selection = serde_json::from_str(&serde_json::to_string(&s).unwrap()).unwrap();
         assert_eq!(back, s);
     }

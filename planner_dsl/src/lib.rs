@@ -88,7 +88,7 @@ pub use crate::limits::Limits;
 pub use crate::plan::Plan;
 pub use crate::registry::{
     function_list_for_prompt, lookup, registry, registry_markdown, FunctionSpec, ParamSpec,
-    ParamType, BUILTIN_ALLOW_LIST, FORBIDDEN,
+    ParamType, BUILTIN_ALLOW_LIST, FORBIDDEN, SELECTION_KEYS,
 };
 pub use crate::trace::{DryRun, RunOutcome, TraceEntry};
 pub use crate::validate::CallSite;

@@ -542,7 +542,8 @@ impl<'a> Host<'a> {
         }
     }
 
-    /// A selection map: `#{ordinal, colour, not_colour, order, region, near}`.
+    /// A selection map: `#{ordinal, colour, not_colour, order, region, near, other_than}`
+    /// ([`crate::registry::SELECTION_KEYS`]).
     fn selection_arg(
         &self,
         spec: &FunctionSpec,
@@ -550,7 +551,6 @@ impl<'a> Host<'a> {
         a: &Dynamic,
         name: String,
     ) -> Result<Selection, CallError> {
-        const KEYS: &str = "ordinal, colour, not_colour, order, region, near";
         let mut sel = Selection::new(name);
         if a.is_unit() {
             return Ok(sel);
@@ -572,29 +572,48 @@ impl<'a> Host<'a> {
                 "not_colour" | "not_color" => sel.not_colour = self.colour_arg(spec, idx, v)?,
                 "order" => sel.order = self.order_arg(spec, idx, v)?,
                 "region" => sel.region = Some(self.name_arg(spec, idx, v)?),
-                "near" => match self.target(spec, idx, v)? {
-                    Target::Instance(i) => sel.near = Some(i.id),
-                    Target::Region(r) => {
-                        return Err(arg_err(
-                            spec,
-                            idx,
-                            format!(
-                                "key `near` must be an object, got the region {:?} (use `region`)",
-                                r.name
-                            ),
-                        ))
-                    }
-                },
+                "near" => sel.near = Some(self.object_key(spec, idx, v, "near")?),
+                "other_than" => {
+                    sel.other_than = Some(self.object_key(spec, idx, v, "other_than")?)
+                }
                 other => {
                     return Err(arg_err(
                         spec,
                         idx,
-                        format!("has an unknown key `{other}`; the keys are {KEYS}"),
+                        format!(
+                            "has an unknown key `{other}`; the keys are {}",
+                            crate::registry::SELECTION_KEYS.join(", ")
+                        ),
                     ))
                 }
             }
         }
         Ok(sel)
+    }
+
+    /// The instance id of an object-valued selection key (`near`, `other_than`); a
+    /// region there is an argument error naming the key.
+    fn object_key(
+        &self,
+        spec: &FunctionSpec,
+        idx: usize,
+        a: &Dynamic,
+        key: &str,
+    ) -> Result<u32, CallError> {
+        match self.target(spec, idx, a)? {
+            Target::Instance(i) => Ok(i.id),
+            Target::Region(r) => {
+                let hint = if key == "near" { " (use `region`)" } else { "" };
+                Err(arg_err(
+                    spec,
+                    idx,
+                    format!(
+                        "key `{key}` must be an object, got the region {:?}{hint}",
+                        r.name
+                    ),
+                ))
+            }
+        }
     }
 
     fn ordinal_arg(&self, spec: &FunctionSpec, idx: usize, a: &Dynamic) -> Result<i64, CallError> {

@@ -34,8 +34,8 @@ pub enum ParamType {
     /// The id of an object on the map (as the conversation names the objects it visited).
     Id,
     /// What else the person said about the object, as a map with any of the keys
-    /// `ordinal`, `colour`, `not_colour`, `order`, `region` and `near` (another object):
-    /// `#{ordinal: 2, near: table}`.
+    /// `ordinal`, `colour`, `not_colour`, `order`, `region`, `near` (another object) and
+    /// `other_than` (an object left out) ([`SELECTION_KEYS`]): `#{ordinal: 2, near: table}`.
     Selection,
 }
 
@@ -54,7 +54,7 @@ impl ParamType {
             ParamType::Text => "string",
             ParamType::Id => "integer id of an object on the map",
             ParamType::Selection => {
-                "map #{ordinal, colour, not_colour, order, region, near}, every key optional"
+                "map #{ordinal, colour, not_colour, order, region, near, other_than}, every key optional"
             }
         }
     }
@@ -135,6 +135,17 @@ impl FunctionSpec {
         }
     }
 }
+
+/// The keys of a selection map ([`ParamType::Selection`]), as the runtime reads them.
+pub const SELECTION_KEYS: [&str; 7] = [
+    "ordinal",
+    "colour",
+    "not_colour",
+    "order",
+    "region",
+    "near",
+    "other_than",
+];
 
 const fn req(name: &'static str, ty: ParamType, doc: &'static str) -> ParamSpec {
     ParamSpec {
@@ -245,7 +256,7 @@ const SELECT_PARAMS: &[ParamSpec] = &[
     opt(
         "select",
         ParamType::Selection,
-        "ordinal: k-th (1 = first, -1 = last, -2 = second to last); colour; not_colour: a colour it must not have; order: what the ordinal counts in (default near_to_far; largest_to_smallest for \"the biggest\"); region: a room it is in; near: an object it is next to (distances then count from that object)",
+        "ordinal: k-th (1 = first, -1 = last, -2 = second to last); colour; not_colour: a colour it must not have; order: what the ordinal counts in (default near_to_far; largest_to_smallest for \"the biggest\"); region: a room it is in; near: an object it is next to (distances then count from that object); other_than: an object of the same kind it is not (\"the other red chair\": the one visited left out)",
     ),
 ];
 
@@ -642,6 +653,15 @@ pub fn registry_markdown() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_selection_docs_name_every_key() {
+        let doc = SELECT_PARAMS[1].doc;
+        for key in SELECTION_KEYS {
+            assert!(ParamType::Selection.describe().contains(key), "{key}");
+            assert!(doc.contains(&format!("{key}:")), "{key}");
+        }
+    }
 
     #[test]
     fn paper_functions_are_all_present() {

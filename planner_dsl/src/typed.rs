@@ -388,6 +388,9 @@ impl Reader {
                                 "order" => t.order = self.order(Some(v), f)?,
                                 "region" => t.region = self.opt_string(Some(v), f)?,
                                 "near" => t.near = Some(Box::new(self.object(v, f)?)),
+                                "other_than" => {
+                                    t.other_than = Some(Box::new(self.object(v, f)?));
+                                }
                                 other => {
                                     return Err(self.arg_err(
                                         key.pos,
@@ -525,6 +528,9 @@ fn target_call(t: &Target, function: &str) -> String {
     if let Some(o) = &t.near {
         keys.push(format!("near: {}", o.to_rhai()));
     }
+    if let Some(o) = &t.other_than {
+        keys.push(format!("other_than: {}", o.to_rhai()));
+    }
     if keys.is_empty() {
         format!("agent.{function}({})", lit(&t.name))
     } else {
@@ -549,20 +555,25 @@ impl Object {
 
 impl Object {
     /// Every selection inside this object expression, outermost first (a pick and,
-    /// recursively, its `near` anchor).
+    /// recursively, its `near` anchor and the object its `other_than` leaves out).
     #[must_use]
     pub fn targets(&self) -> Vec<&Target> {
         let mut out = Vec::new();
-        let mut cur = self;
-        while let Object::Pick(t) = cur {
+        if let Object::Pick(t) = self {
             out.push(t);
-            match &t.near {
-                Some(o) => cur = o,
-                None => break,
-            }
+            out.extend(inner_targets(t));
         }
         out
     }
+}
+
+/// The selections inside a target's object-valued keys (`near`, then `other_than`).
+fn inner_targets(t: &Target) -> Vec<&Target> {
+    [&t.near, &t.other_than]
+        .into_iter()
+        .flatten()
+        .flat_map(|o| o.targets())
+        .collect()
 }
 
 impl Step {
@@ -573,9 +584,7 @@ impl Step {
         match self {
             Step::Let { target, .. } | Step::BetweenTwo(target) => {
                 let mut v = vec![target];
-                if let Some(o) = &target.near {
-                    v.extend(o.targets());
-                }
+                v.extend(inner_targets(target));
                 v
             }
             Step::GoTo(o) | Step::Face(o) | Step::Side { object: o, .. } => o.targets(),

@@ -302,6 +302,20 @@ fn get_obj_takes_a_selection_map() {
     assert!(e.message.contains("use `region`"), "{e}");
     let e = id_of("get_obj(\"table\", #{not_colour: \"yellow\", colour: \"yellow\"})").unwrap_err();
     assert_eq!(e.kind, RuntimeErrorKind::Map);
+    // "now the other sofa", after the red sofa (id 1): the black one (id 2)
+    assert_eq!(
+        id_of("get_obj(\"sofa\", #{other_than: get_instance(1)})").unwrap(),
+        "2"
+    );
+    assert_eq!(
+        id_of("get_obj(\"sofa\", #{other_than: get_obj(\"sofa\", #{colour: \"black\"})})").unwrap(),
+        "1"
+    );
+    let e = id_of("get_obj(\"sofa\", #{other_than: get_instance(3)})").unwrap_err();
+    assert_eq!(e.kind, RuntimeErrorKind::Map);
+    assert!(e.message.contains("is a table, not a sofa"), "{e}");
+    let e = id_of("get_obj(\"sofa\", #{other_than: \"kitchen\"})").unwrap_err();
+    assert!(e.message.contains("`other_than` must be an object"), "{e}");
 }
 
 /// "Between the two yellow tables" needs exactly two; "come back here" returns to where

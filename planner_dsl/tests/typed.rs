@@ -116,6 +116,43 @@ fn selections_nest_and_print_canonically() {
 }
 
 #[test]
+fn the_other_one_holds_the_object_it_leaves_out() {
+    // "now the other red chair", after red chair 9; and within one instruction, a
+    // variable bound to the first
+    let p = TypedPlan::parse(
+        "move_to_object(get_obj(\"chair\", #{colour: \"red\", other_than: get_instance(9)}));\n\
+         let c = get_obj(\"sofa\");\nmove_to_object(get_obj(\"sofa\", #{other_than: c}));",
+    )
+    .unwrap();
+    assert_eq!(
+        p.steps[0],
+        Step::GoTo(Object::Pick(Target {
+            name: "chair".into(),
+            colour: Some("red".into()),
+            other_than: Some(Box::new(Object::Instance(9))),
+            ..Target::default()
+        }))
+    );
+    assert_eq!(
+        p.to_rhai(),
+        "agent.move_to_object(agent.get_obj(\"chair\", #{colour: \"red\", other_than: agent.get_instance(9)}));\n\
+         let c = agent.get_obj(\"sofa\");\nagent.move_to_object(agent.get_obj(\"sofa\", #{other_than: c}));\n"
+    );
+    assert_eq!(TypedPlan::parse(&p.to_rhai()).unwrap(), p);
+    // a pick inside it is one of the step's targets, as a `near` anchor is
+    let q = TypedPlan::parse(
+        "move_to_object(get_obj(\"chair\", #{other_than: get_obj(\"chair\", #{colour: \"red\"})}));",
+    )
+    .unwrap();
+    let names: Vec<(&str, Option<&str>)> = q.steps[0]
+        .targets()
+        .iter()
+        .map(|t| (t.name.as_str(), t.colour.as_deref()))
+        .collect();
+    assert_eq!(names, [("chair", None), ("chair", Some("red"))]);
+}
+
+#[test]
 fn comment_lines_are_not_steps_and_keep_positions() {
     // The language layer's answers quote the person's words in a comment above each call.
     let plain = "move_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to_start();";
@@ -188,6 +225,7 @@ fn arb_target() -> impl Strategy<Value = Target> {
                 order: ObjectOrder::ALL[order].0,
                 region: nonempty(region),
                 near: None,
+                other_than: None,
             }
         })
 }
@@ -197,11 +235,13 @@ proptest! {
     fn printed_plans_parse_back_to_themselves(
         t in arb_target(),
         near in proptest::option::of(arb_target()),
+        other in proptest::option::of(0u32..100),
         angle in -720.0f64..720.0,
         text in "\\PC{0,12}",
     ) {
         let mut t = t;
         t.near = near.map(|n| Box::new(Object::Pick(n)));
+        t.other_than = other.map(|id| Box::new(Object::Instance(id)));
         let p = TypedPlan {
             steps: vec![
                 Step::Let { var: "x".into(), target: t.clone() },

@@ -1036,17 +1036,12 @@ pub(crate) fn unsaid_directions<'a>(instruction: &str, plan: &'a TypedPlan) -> V
 /// bed" answered with `#{ordinal: 2, near: ...}`, seen on people.nav; "the yellow table
 /// that's furthest from you" with `#{ordinal: 3, order: "far_to_near"}`). The first and
 /// the last (1, -1) are said in too many ways ("nearest", "furthest", "the last") to be
-/// judged here; [`check_words`] checks the superlatives. In a conversation (`in_chat`)
-/// counts are not judged: "the next one" may count on from what was visited. No worked
-/// example may have one.
-pub(crate) fn unsaid_ordinals<'a>(
-    instruction: &str,
-    in_chat: bool,
-    plan: &'a TypedPlan,
-) -> Vec<&'a Target> {
-    if in_chat {
-        return Vec::new();
-    }
+/// judged here; [`check_words`] checks the superlatives. In a conversation too: "the
+/// other one" leaves a visited instance out (`other_than`) and "the same one" names it
+/// (`get_instance`); measured on the chat suite (dev), with counts open there the default
+/// model wrote a visited instance's id as the ordinal ("now the other red chair" after
+/// red chair 9 as `#{ordinal: 9, colour: "red"}`). No worked example may have one.
+pub(crate) fn unsaid_ordinals<'a>(instruction: &str, plan: &'a TypedPlan) -> Vec<&'a Target> {
     let said = counts_said(instruction);
     targets(plan)
         .into_iter()
@@ -1148,7 +1143,7 @@ pub fn check_answer(
         (unsaid_sizes(instruction, plan), &sizes, ""),
         (unsaid_far_ends(instruction, plan), &far_ends, ""),
         (unsaid_regions(instruction, in_chat, plan), &regions, ""),
-        (unsaid_ordinals(instruction, in_chat, plan), &ordinals, ""),
+        (unsaid_ordinals(instruction, plan), &ordinals, ""),
     ];
     for (targets, to_model, how) in unsaid {
         out.extend(unsaid_findings(map, pose, targets, to_model, |t| {
@@ -1450,25 +1445,30 @@ pub(crate) mod tests {
             let (found, f) = counted(instruction, select);
             assert!(!found, "{instruction} {select}: {f:?}");
         }
-        // In a conversation a count may follow from what was visited ("the next one").
+        // In a conversation too: a visited instance's id written as the count ("now the
+        // other red chair" after red chair 9, seen on the chat suite) is found; "the
+        // other one" has its own key, and a said count stays said.
         let m = map();
-        let a = parse_answer(
-            "objects: [(table, None, None)]\nplan:\nmove_to_object(get_obj(\"table\", #{ordinal: 2}));",
-        )
-        .unwrap();
-        let f = check_answer(
-            &m,
-            "now the next one",
-            &a.tuples,
-            &a.plan,
-            m.start_pose,
-            &[],
-            &[8],
-        );
-        assert!(
-            f.iter().all(|x| !x.to_model.contains("no such count")),
-            "{f:?}"
-        );
+        for (instruction, select, found) in [
+            ("now the other table", "#{ordinal: 8}", true),
+            (
+                "now the other table",
+                "#{other_than: get_instance(8)}",
+                false,
+            ),
+            ("now the second table", "#{ordinal: 2}", false),
+        ] {
+            let a = parse_answer(&format!(
+                "objects: [(table, None, None)]\nplan:\nmove_to_object(get_obj(\"table\", {select}));"
+            ))
+            .unwrap();
+            let f = check_answer(&m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[8]);
+            assert_eq!(
+                f.iter().any(|x| x.to_model.contains("no such count")),
+                found,
+                "{instruction} {select}: {f:?}"
+            );
+        }
     }
 
     #[test]

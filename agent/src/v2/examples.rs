@@ -281,7 +281,7 @@ mod tests {
             let unsaid = super::super::check::unsaid_far_ends(&e.instruction, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let in_chat = e.history.is_some();
-            let unsaid = super::super::check::unsaid_ordinals(&e.instruction, in_chat, &a.plan);
+            let unsaid = super::super::check::unsaid_ordinals(&e.instruction, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let unsaid = super::super::check::unsaid_regions(&e.instruction, in_chat, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);

@@ -466,7 +466,8 @@ impl SelKeys<'_> {
 /// The selection map `selmap{suffix}`: its keys in any order, each at most once, at
 /// least one (as a Rhai map literal takes them); colours from the rule `colour` (none:
 /// no colour keys), regions from the rule `region` (none: no region key). Its key rules
-/// are `sel{suffix}_{written}_{pending}`, one per state of [`SelState`] reached.
+/// are `sel{suffix}_{written}_{pending}`, one per state of [`SelState`] reached. In a
+/// conversation (`vocab.ids`), `other_than: get_instance(id)` may end the map.
 ///
 /// Measured on held-out v2 (dev): with the keys in one fixed order (ordinal, colour,
 /// not_colour, order, region, near), the default model, whose own order was
@@ -522,7 +523,7 @@ fn selection_rules(
             continue;
         }
         done.push(s);
-        let alternatives: Vec<String> = keys
+        let mut alternatives: Vec<String> = keys
             .next(s)
             .into_iter()
             .filter_map(|(key, after)| {
@@ -538,6 +539,12 @@ fn selection_rules(
                 }
             })
             .collect();
+        // "The other red chair": in a conversation the map may end in the instance it
+        // leaves out, one the conversation visited. Last and once, so that it adds no
+        // states (each key written doubles them).
+        if !vocab.ids.is_empty() && keys.may_end(s) {
+            alternatives.push("\"other_than: \" inst".into());
+        }
         w.rule(&name(s), &alternatives.join(" | "));
     }
 }
@@ -971,6 +978,47 @@ pub(crate) mod tests {
         v.ids.sort_unstable();
         v.ids.dedup();
         v
+    }
+
+    #[test]
+    fn the_other_one_leaves_out_a_visited_instance_last() {
+        let mut conversation = vocab();
+        conversation.ids = vec![4, 9];
+        let pick = |sel: &str| {
+            format!("objects: [(chair, None, red)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));")
+        };
+        assert_offers(
+            &answer_lark(&conversation),
+            pick,
+            &[
+                "other_than: get_instance(9)",
+                "colour: \"red\", other_than: get_instance(4)",
+                "ordinal: 2, region: \"kitchen\", other_than: get_instance(9)",
+            ],
+            &[
+                // an id the conversation did not visit, a second key after it, twice
+                "other_than: get_instance(5)",
+                "other_than: get_instance(9), colour: \"red\"",
+                "other_than: get_instance(9), other_than: get_instance(4)",
+                "other_than: get_obj(\"chair\")",
+            ],
+        );
+        // outside a conversation there is nothing visited to leave out
+        assert_offers(
+            &answer_lark(&vocab()),
+            pick,
+            &["colour: \"red\""],
+            &["other_than: get_instance(9)"],
+        );
+        // a required colour comes first
+        let mut required = conversation.clone();
+        required.colour_required = vec!["chair".into()];
+        assert_offers(
+            &answer_lark(&required),
+            pick,
+            &["colour: \"red\", other_than: get_instance(9)"],
+            &["other_than: get_instance(9)"],
+        );
     }
 
     #[test]

@@ -196,8 +196,8 @@ fn settle(findings: &[Finding]) -> Outcome {
 }
 
 /// Narrows `v` to what the person said ([`PlanOptions::said_only`](crate::PlanOptions)):
-/// the counts the instruction says and the regions it names for the `region` key
-/// (outside a conversation), directional orders only when it names a direction, orders
+/// the counts the instruction says, the regions it names for the `region` key (outside
+/// a conversation), directional orders only when it names a direction, orders
 /// by size only when it speaks of size, `far_to_near` only when it speaks of the far end.
 /// The same tests as the checks' ([`check::counts_said`], [`check::region_said`],
 /// [`check::direction_said`], [`check::size_said`], [`check::far_end_said`]), so the
@@ -210,14 +210,14 @@ fn settle(findings: &[Finding]) -> Outcome {
 /// colour narrowed per object (the said colours that object has on this map) would
 /// need one selection rule per colour set; until then the checks judge colours.
 fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>) {
+    let counts = check::counts_said(instruction);
+    v.ordinals = Some(
+        (1..=20)
+            .flat_map(|k| [k, -k])
+            .filter(|&k| check::ordinal_said(&counts, k))
+            .collect(),
+    );
     if ctx.references.is_empty() {
-        let counts = check::counts_said(instruction);
-        v.ordinals = Some(
-            (1..=20)
-                .flat_map(|k| [k, -k])
-                .filter(|&k| check::ordinal_said(&counts, k))
-                .collect(),
-        );
         if ctx.options.said_colours {
             v.colours_of = Some(colours_said_of(ctx.map, instruction));
         }
@@ -636,8 +636,12 @@ mod tests {
     }
 
     #[test]
-    fn in_a_conversation_counts_stay_open() {
-        let v = narrowed("now the next one", &[1]);
-        assert_eq!(v.ordinals, None);
+    fn in_a_conversation_counts_are_the_said_ones_too() {
+        // "the other one" leaves the visited instance out (`other_than`); a visited id
+        // is never on offer as a count
+        let v = narrowed("now the other red chair", &[9]);
+        assert_eq!(v.ordinals, Some(vec![1, -1]));
+        let v = narrowed("now the third one", &[9]);
+        assert_eq!(v.ordinals, Some(vec![1, -1, 3, -3]));
     }
 }
