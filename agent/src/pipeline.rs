@@ -97,6 +97,13 @@ pub struct PlanOptions {
     /// With `said_only`, outside a conversation: a pick of each object may select only
     /// on the colours the person said that some object of that name has on this map.
     pub said_colours: bool,
+    /// Answers drawn again after the greedy answer and the re-ask still disagree with
+    /// the checks, before the person is asked (default 0): each is the re-ask's request
+    /// sampled at `redraw_temperature` with its own seed (1, 2, ...), so a run repeats.
+    /// The first draw the checks accept is the plan; no draw is changed.
+    pub redraws: u32,
+    /// The temperature of those draws (default 0.7).
+    pub redraw_temperature: f32,
 }
 
 impl Default for PlanOptions {
@@ -111,6 +118,8 @@ impl Default for PlanOptions {
             llguidance: true,
             said_only: true,
             said_colours: false,
+            redraws: 0,
+            redraw_temperature: 0.7,
         }
     }
 }
@@ -167,7 +176,8 @@ impl<'a> PlanContext<'a> {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum PlanSource {
-    /// The model wrote it, after `repairs` re-asks (0 or 1).
+    /// The model wrote it, after `repairs` further requests (0; 1 after the re-ask;
+    /// more after redraws).
     Llm {
         /// Re-asks used.
         repairs: u32,

@@ -162,6 +162,47 @@ fn a_second_disagreement_becomes_a_question_not_a_guess() {
 }
 
 #[test]
+fn redraws_sample_the_reask_again_and_the_checks_judge_each() {
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let mut ctx = v2(&map, &robot);
+    ctx.options.redraws = 3;
+    let b = Scripted::new(&[
+        BLACK_SOFA_WRONG,
+        BLACK_SOFA_WRONG,
+        BLACK_SOFA_WRONG,
+        BLACK_SOFA_RIGHT,
+    ]);
+    let instruction = "take me to the sofa, the black one";
+    let out = plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
+    let p = out.plan().expect("the second draw passes the checks");
+    assert_eq!(p.source, PlanSource::Llm { repairs: 3 });
+    // What runs is the draw as the model wrote it.
+    assert!(p.script.contains("#{colour: \"black\"}"), "{}", p.script);
+    let reqs = b.requests();
+    assert_eq!(reqs.len(), 4, "the third draw is not needed");
+    // Greedy answer and re-ask; then the re-ask's request sampled, one seed each.
+    for r in &reqs[..2] {
+        assert!(r.temperature == 0.0 && r.seed.is_none());
+    }
+    for (r, seed) in reqs[2..].iter().zip(1..) {
+        assert_eq!(r.messages, reqs[1].messages);
+        assert_eq!(
+            (r.lark.as_ref(), r.grammar.as_ref()),
+            (reqs[1].lark.as_ref(), reqs[1].grammar.as_ref())
+        );
+        assert!(r.temperature > 0.0);
+        assert_eq!(r.seed, Some(seed));
+    }
+
+    // Every draw disagreeing: still a question, after 1 + 1 + 3 requests.
+    let b = Scripted::new(&[BLACK_SOFA_WRONG; 5]);
+    let out = plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
+    assert!(matches!(out, Outcome::Question(_)), "{out:?}");
+    assert_eq!(b.requests().len(), 5);
+}
+
+#[test]
 fn an_object_the_map_lacks_is_refused_after_the_reask() {
     let piano = "objects: [(piano, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\n";
     let (out, _) = plan_scripted(&[piano, piano], "go to the piano");

@@ -206,6 +206,14 @@ pub(crate) enum FlashAttention {
     Auto,
 }
 
+/// A sampling temperature: a finite number above 0.
+fn temperature(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(t) if t.is_finite() && t > 0.0 => Ok(t),
+        _ => Err(format!("`{s}` is not a temperature above 0 (e.g. 0.7)")),
+    }
+}
+
 /// Backend settings shared by every command that talks to a model.
 #[derive(Debug, Args)]
 pub(crate) struct ModelArgs {
@@ -261,6 +269,14 @@ pub(crate) struct ModelArgs {
     /// has on the map (outside a conversation; for comparison).
     #[arg(long, conflicts_with = "open_selections")]
     pub(crate) said_colours: bool,
+    /// After the re-ask still disagrees with the checks, draw up to N more answers
+    /// (sampled, seeds 1..N) before asking the person; the first the checks accept is
+    /// the plan.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub(crate) redraws: u32,
+    /// The temperature of those draws.
+    #[arg(long, value_name = "T", default_value_t = 0.7, value_parser = temperature)]
+    pub(crate) redraw_temperature: f32,
 }
 
 impl ModelArgs {
@@ -295,7 +311,21 @@ impl ModelArgs {
             answer_grammar: !self.no_grammar,
             said_only: !self.open_selections,
             said_colours: self.said_colours,
+            redraws: self.redraws,
+            redraw_temperature: self.redraw_temperature,
             ..PlanOptions::default()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_redraw_temperature_is_a_finite_number_above_zero() {
+        assert_eq!(super::temperature("0.7"), Ok(0.7));
+        for bad in ["0", "-1", "nan", "inf", "warm"] {
+            let e = super::temperature(bad).unwrap_err();
+            assert!(e.contains(bad), "{e}");
         }
     }
 }

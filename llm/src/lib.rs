@@ -112,6 +112,10 @@ pub struct CompletionRequest {
     /// Sampling temperature; 0 means greedy (deterministic).
     #[serde(default)]
     pub temperature: f32,
+    /// Seed of the sampler when `temperature` > 0 (the backend's own when `None`): two
+    /// requests alike but for their seed draw two answers. Ignored when greedy.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u32>,
     /// Generation ends before any of these strings (which are not part of the answer).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stop: Vec<String>,
@@ -141,6 +145,7 @@ impl CompletionRequest {
             messages,
             max_tokens,
             temperature: 0.0,
+            seed: None,
             stop: Vec::new(),
             grammar: None,
             lark: None,

@@ -64,7 +64,7 @@ pub struct LlamaCppConfig {
     pub top_k: i32,
     /// Top-p for temperature sampling (ignored when greedy; default 0.95).
     pub top_p: f32,
-    /// Seed for temperature sampling (default 42).
+    /// Seed for temperature sampling when a request gives none (default 42).
     pub seed: u32,
     /// Overrides the model's chat template: a llama.cpp template name ("chatml", "llama2",
     /// "llama3", ...) or a template string. `None`: the model's own, else ChatML.
@@ -601,7 +601,7 @@ impl Worker<'_> {
             chain.push(LlamaSampler::top_k(self.cfg.top_k));
             chain.push(LlamaSampler::top_p(self.cfg.top_p, 1));
             chain.push(LlamaSampler::temp(req.temperature));
-            chain.push(LlamaSampler::dist(self.cfg.seed));
+            chain.push(LlamaSampler::dist(req.seed.unwrap_or(self.cfg.seed)));
         }
         Ok(Sampling {
             chain: LlamaSampler::chain_simple(chain),

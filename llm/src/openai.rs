@@ -224,6 +224,9 @@ impl OpenAiBackend {
         if !req.stop.is_empty() {
             body["stop"] = json!(req.stop);
         }
+        if let (Some(seed), true) = (req.seed, req.temperature > 0.0) {
+            body["seed"] = json!(seed);
+        }
         if with_schema {
             if let Some(schema) = &req.json_schema {
                 body["response_format"] = json!({
@@ -550,6 +553,16 @@ mod tests {
         assert_eq!(cfg.api_key.as_deref(), Some("sk-1"));
         assert_eq!(cfg.model, "default");
         assert!(!format!("{cfg:?}").contains("sk-1"), "key leaks into Debug");
+    }
+
+    #[test]
+    fn a_seed_is_sent_only_with_a_temperature() {
+        let b = OpenAiBackend::new(OpenAiConfig::new("http://127.0.0.1:1", "m")).unwrap();
+        let mut req = CompletionRequest::new(vec![crate::ChatMessage::user("hi")], 8);
+        req.seed = Some(7);
+        assert!(b.body(&req, false).get("seed").is_none());
+        req.temperature = 0.5;
+        assert_eq!(b.body(&req, false)["seed"], 7);
     }
 
     #[test]

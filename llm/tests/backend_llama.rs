@@ -93,6 +93,28 @@ fn completion_returns_text_and_counts() {
 }
 
 #[test]
+fn a_request_seed_picks_the_draw() {
+    let _g = serial();
+    let Some(b) = smol(2048) else { return };
+    let draw = |seed: u32| {
+        let mut r = ask(
+            "You are a storyteller.",
+            "Tell me a story about a robot.",
+            24,
+        );
+        r.temperature = 1.0;
+        r.seed = Some(seed);
+        b.complete(&r).unwrap().text
+    };
+    let first = draw(1);
+    assert_eq!(first, draw(1), "the same seed draws the same answer");
+    assert!(
+        (2..6).any(|s| draw(s) != first),
+        "other seeds draw other answers"
+    );
+}
+
+#[test]
 fn max_tokens_cuts_generation_with_length_reason() {
     let _g = serial();
     let Some(b) = smol(2048) else { return };

@@ -352,11 +352,18 @@ pub fn plan_instruction(
     let mut timing = Timing::default();
     let mut attempts = Vec::new();
     let mut findings = Vec::new();
-    let last_round = u32::from(ctx.options.reask);
+    // Greedy rounds: the answer, then (with `reask`) the re-ask. Then the redraws: the
+    // last greedy request sampled, one seed each (see `PlanOptions::redraws`).
+    let greedy_rounds = u32::from(ctx.options.reask);
+    let last_round = greedy_rounds + ctx.options.redraws;
     for round in 0..=last_round {
         let mut req = CompletionRequest::new(msgs.clone(), ctx.options.plan_max_tokens);
         req.grammar.clone_from(&grammar);
         req.lark.clone_from(&lark);
+        if round > greedy_rounds {
+            req.temperature = ctx.options.redraw_temperature;
+            req.seed = Some(round - greedy_rounds);
+        }
         let c = backend.complete(&req)?;
         timing.add(&c);
         attempts.push(c.text.clone());
@@ -375,6 +382,11 @@ pub fn plan_instruction(
             }
             Err(f) if round == last_round => {
                 tracing::debug!(round, answer = %c.text, findings = ?f, "answer still disagrees");
+                findings = f;
+            }
+            Err(f) if round >= greedy_rounds => {
+                // The re-ask's request again, drawn with the next seed.
+                tracing::debug!(round, answer = %c.text, findings = ?f, "answer disagrees; drawing again");
                 findings = f;
             }
             Err(f) => {
