@@ -98,9 +98,11 @@ pub struct PlanOptions {
     /// on the colours the person said that some object of that name has on this map.
     pub said_colours: bool,
     /// Answers drawn again after the greedy answer and the re-ask still disagree with
-    /// the checks, before the person is asked (default 0): each is the re-ask's request
+    /// the checks, before the person is asked (default 1): each is the re-ask's request
     /// sampled at `redraw_temperature` with its own seed (1, 2, ...), so a run repeats.
-    /// The first draw the checks accept is the plan; no draw is changed.
+    /// The first draw the checks accept is the plan; no draw is changed. Measured on
+    /// held-out v2 (dev): 3 draws mended 2 of 13 tasks, both with the first draw
+    /// (README, "The language layer").
     pub redraws: u32,
     /// The temperature of those draws (default 0.7).
     pub redraw_temperature: f32,
@@ -118,7 +120,7 @@ impl Default for PlanOptions {
             llguidance: true,
             said_only: true,
             said_colours: false,
-            redraws: 0,
+            redraws: 1,
             redraw_temperature: 0.7,
         }
     }

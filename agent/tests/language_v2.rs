@@ -4,7 +4,8 @@
 //! under the grammar built from the registry and the map every answer reads as a typed
 //! plan naming only what the map holds. With scripted answers (the model's side fixed,
 //! so that each path is taken for sure): a disagreement gets one targeted re-ask, a second
-//! disagreement a question or a refusal, and what runs is exactly what the model wrote.
+//! one a sampled redraw of the re-ask, a third a question or a refusal, and what runs is
+//! exactly what the model wrote.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use std::collections::VecDeque;
@@ -148,7 +149,7 @@ fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
 #[test]
 fn a_second_disagreement_becomes_a_question_not_a_guess() {
     let (out, reqs) = plan_scripted(
-        &[BLACK_SOFA_WRONG, BLACK_SOFA_WRONG],
+        &[BLACK_SOFA_WRONG, BLACK_SOFA_WRONG, BLACK_SOFA_WRONG],
         "take me to the sofa, the black one",
     );
     match out {
@@ -158,7 +159,11 @@ fn a_second_disagreement_becomes_a_question_not_a_guess() {
         }
         other => panic!("expected a question, got {other:?}"),
     }
-    assert_eq!(reqs.len(), 2, "one re-ask, no more");
+    assert_eq!(
+        reqs.len(),
+        3,
+        "one re-ask and one draw (the default), no more"
+    );
 }
 
 #[test]
@@ -205,7 +210,7 @@ fn redraws_sample_the_reask_again_and_the_checks_judge_each() {
 #[test]
 fn an_object_the_map_lacks_is_refused_after_the_reask() {
     let piano = "objects: [(piano, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\n";
-    let (out, _) = plan_scripted(&[piano, piano], "go to the piano");
+    let (out, _) = plan_scripted(&[piano, piano, piano], "go to the piano");
     match out {
         Outcome::Refusal(r) => assert!(r.contains("piano") && r.contains("sofa"), "{r}"),
         other => panic!("expected a refusal, got {other:?}"),
@@ -214,10 +219,10 @@ fn an_object_the_map_lacks_is_refused_after_the_reask() {
 
 #[test]
 fn a_map_error_in_the_dry_run_is_asked_about() {
-    // flat-a has two sofas: a 7th does not exist, whatever the model says twice.
+    // flat-a has two sofas: a 7th does not exist, whatever the model says three times.
     let seventh =
         "objects: [(sofa, 7, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{ordinal: 7}));\n";
-    let (out, _) = plan_scripted(&[seventh, seventh], "go to the seventh sofa");
+    let (out, _) = plan_scripted(&[seventh, seventh, seventh], "go to the seventh sofa");
     match out {
         Outcome::Question(q) => assert!(q.contains("sofa"), "{q}"),
         other => panic!("expected a question, got {other:?}"),

@@ -117,9 +117,10 @@ fn reask_replays_from_a_recorded_cassette() {
     );
     let label = judge(&res, &map);
     println!("{label}");
-    // One request, and at most one re-ask: the same request with what the checks found
-    // appended to its last message (the first answer is not replayed to the model).
-    assert!((1..=2).contains(&records.len()), "{}", records.len());
+    // One request, at most one re-ask (the same request with what the checks found
+    // appended to its last message; the first answer is not replayed to the model), and
+    // at most one redraw (the default): the re-ask's request, sampled with seed 1.
+    assert!((1..=3).contains(&records.len()), "{}", records.len());
     let first = &records[0].request.messages;
     assert_eq!(first.last().unwrap().role, Role::User);
     assert!(first.last().unwrap().content.ends_with(INSTRUCTION));
@@ -134,9 +135,20 @@ fn reask_replays_from_a_recorded_cassette() {
             "{last}"
         );
     }
+    if let Some(third) = records.get(2) {
+        let (second, third) = (&records[1].request, &third.request);
+        assert_eq!(third.messages, second.messages);
+        assert_eq!(third.lark, second.lark);
+        assert!(third.temperature > 0.0 && second.temperature == 0.0);
+        assert_eq!(third.seed, Some(1));
+    }
     // The outcome matches how many answers were recorded.
     match &res {
         Ok(Outcome::Plan(p)) => assert_eq!(records.len(), p.attempts.len()),
-        _ => assert_eq!(records.len(), 2, "a question comes after the re-ask"),
+        _ => assert_eq!(
+            records.len(),
+            3,
+            "a question comes after the re-ask and the redraw"
+        ),
     }
 }
