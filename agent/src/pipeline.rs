@@ -294,8 +294,8 @@ pub fn extract_tuples(
     crate::v2::extract(backend, prompts, instruction, options)
 }
 
-/// Plans one instruction with one constrained model call and at most one re-ask; what
-/// stays unsettled becomes a question to the person (or a refusal, for an object the
+/// Plans one instruction with one constrained model call, at most one re-ask and
+/// [`PlanOptions::redraws`] sampled draws of it; what stays unsettled becomes a question to the person (or a refusal, for an object the
 /// map does not hold), never a different plan. See [`crate::v2`].
 ///
 /// # Errors

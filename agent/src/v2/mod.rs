@@ -312,7 +312,8 @@ fn reask_vocabulary(
     Some(v)
 }
 
-/// Plans one instruction with one model call (and at most one re-ask).
+/// Plans one instruction with one model call (and at most one re-ask, then
+/// [`crate::PlanOptions::redraws`] sampled draws of the re-ask's request).
 ///
 /// # Errors
 /// [`LanguageError`]: prompts or backend. A plan that does not settle is an
