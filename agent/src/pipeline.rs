@@ -99,7 +99,8 @@ pub struct PlanOptions {
     pub said_colours: bool,
     /// Answers drawn again after the greedy answer and the re-ask still disagree with
     /// the checks, before the person is asked (default 1): each is the re-ask's request
-    /// sampled at `redraw_temperature` with its own seed (1, 2, ...), so a run repeats.
+    /// (the first request with `reask` off) sampled at `redraw_temperature` with its
+    /// own seed (1, 2, ...), so a run repeats.
     /// The first draw the checks accept is the plan; no draw is changed. Measured on
     /// held-out v2 (dev): 3 draws mended 2 of 13 tasks, both with the first draw
     /// (README, "The language layer").
@@ -181,7 +182,7 @@ pub enum PlanSource {
     /// The model wrote it, after `repairs` further requests (0; 1 after the re-ask;
     /// more after redraws).
     Llm {
-        /// Re-asks used.
+        /// Requests after the first: the re-ask, then any redraws.
         repairs: u32,
     },
 }
@@ -295,8 +296,9 @@ pub fn extract_tuples(
 }
 
 /// Plans one instruction with one constrained model call, at most one re-ask and
-/// [`PlanOptions::redraws`] sampled draws of it; what stays unsettled becomes a question to the person (or a refusal, for an object the
-/// map does not hold), never a different plan. See [`crate::v2`].
+/// [`PlanOptions::redraws`] sampled draws of it; what stays unsettled becomes a
+/// question to the person (or a refusal, for an object the map does not hold), never a
+/// different plan. See [`crate::v2`].
 ///
 /// # Errors
 /// [`LanguageError`]: prompts or backend.
