@@ -147,7 +147,7 @@ fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
 }
 
 #[test]
-fn a_second_disagreement_becomes_a_question_not_a_guess() {
+fn a_disagreement_left_after_the_redraw_becomes_a_question_not_a_guess() {
     let (out, reqs) = plan_scripted(
         &[BLACK_SOFA_WRONG, BLACK_SOFA_WRONG, BLACK_SOFA_WRONG],
         "take me to the sofa, the black one",

@@ -272,10 +272,15 @@ pub(crate) struct ModelArgs {
     /// After the re-ask still disagrees with the checks, draw up to N more answers
     /// (sampled, seeds 1..N) before asking the person; the first the checks accept is
     /// the plan.
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(long, value_name = "N", default_value_t = PlanOptions::default().redraws)]
     pub(crate) redraws: u32,
     /// The temperature of those draws.
-    #[arg(long, value_name = "T", default_value_t = 0.7, value_parser = temperature)]
+    #[arg(
+        long,
+        value_name = "T",
+        default_value_t = PlanOptions::default().redraw_temperature,
+        value_parser = temperature
+    )]
     pub(crate) redraw_temperature: f32,
 }
 
