@@ -148,10 +148,7 @@ fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
 
 #[test]
 fn a_disagreement_left_after_the_redraw_becomes_a_question_not_a_guess() {
-    let (out, reqs) = plan_scripted(
-        &[BLACK_SOFA_WRONG, BLACK_SOFA_WRONG, BLACK_SOFA_WRONG],
-        "take me to the sofa, the black one",
-    );
+    let (out, reqs) = plan_scripted(&[BLACK_SOFA_WRONG; 4], "take me to the sofa, the black one");
     match out {
         Outcome::Question(q) => {
             assert!(q.contains("black"), "{q}");
@@ -161,8 +158,40 @@ fn a_disagreement_left_after_the_redraw_becomes_a_question_not_a_guess() {
     }
     assert_eq!(
         reqs.len(),
-        3,
-        "one re-ask and one draw (the default), no more"
+        4,
+        "one re-ask, the reversed examples' answer and one sampled draw (the defaults), no more"
+    );
+}
+
+#[test]
+fn after_the_reask_the_first_request_with_its_examples_reversed_is_answered_greedily() {
+    let (out, reqs) = plan_scripted(
+        &[BLACK_SOFA_WRONG, BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT],
+        "take me to the sofa, the black one",
+    );
+    let p = out
+        .plan()
+        .expect("the reversed examples' answer passes the checks");
+    assert_eq!(p.source, PlanSource::Llm { repairs: 2 });
+    assert!(p.script.contains("#{colour: \"black\"}"), "{}", p.script);
+    assert_eq!(reqs.len(), 3);
+    let (first, reask, reversed) = (&reqs[0], &reqs[1], &reqs[2]);
+    // The same messages as the first request (no findings), the worked examples (request
+    // and answer pairs between the system message and the request) in reverse order.
+    let n = first.messages.len();
+    assert!(n > 5, "worked examples follow the system message");
+    assert_eq!(reversed.messages.len(), n);
+    assert_eq!(reversed.messages[0], first.messages[0]);
+    assert_eq!(reversed.messages[n - 1], first.messages[n - 1]);
+    assert_eq!(reversed.messages[1], first.messages[n - 3]);
+    assert_eq!(reversed.messages[2], first.messages[n - 2]);
+    assert_eq!(reversed.messages[n - 2], first.messages[2]);
+    assert_ne!(reversed.messages, first.messages);
+    // Greedy, under the re-ask's grammar.
+    assert!(reversed.temperature == 0.0 && reversed.seed.is_none());
+    assert_eq!(
+        (reversed.lark.as_ref(), reversed.grammar.as_ref()),
+        (reask.lark.as_ref(), reask.grammar.as_ref())
     );
 }
 
@@ -172,6 +201,7 @@ fn redraws_sample_the_reask_again_and_the_checks_judge_each() {
     let robot = SimRobot::new(map.clone());
     let mut ctx = v2(&map, &robot);
     ctx.options.redraws = 3;
+    ctx.options.reversed_draw = false;
     let b = Scripted::new(&[
         BLACK_SOFA_WRONG,
         BLACK_SOFA_WRONG,
@@ -210,7 +240,7 @@ fn redraws_sample_the_reask_again_and_the_checks_judge_each() {
 #[test]
 fn an_object_the_map_lacks_is_refused_after_the_reask() {
     let piano = "objects: [(piano, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\n";
-    let (out, _) = plan_scripted(&[piano, piano, piano], "go to the piano");
+    let (out, _) = plan_scripted(&[piano; 4], "go to the piano");
     match out {
         Outcome::Refusal(r) => assert!(r.contains("piano") && r.contains("sofa"), "{r}"),
         other => panic!("expected a refusal, got {other:?}"),
@@ -222,7 +252,7 @@ fn a_map_error_in_the_dry_run_is_asked_about() {
     // flat-a has two sofas: a 7th does not exist, whatever the model says three times.
     let seventh =
         "objects: [(sofa, 7, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{ordinal: 7}));\n";
-    let (out, _) = plan_scripted(&[seventh, seventh, seventh], "go to the seventh sofa");
+    let (out, _) = plan_scripted(&[seventh; 4], "go to the seventh sofa");
     match out {
         Outcome::Question(q) => assert!(q.contains("sofa"), "{q}"),
         other => panic!("expected a question, got {other:?}"),

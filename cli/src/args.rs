@@ -282,6 +282,10 @@ pub(crate) struct ModelArgs {
         value_parser = temperature
     )]
     pub(crate) redraw_temperature: f32,
+    /// After the re-ask, draw no greedy answer with the worked examples in reverse order
+    /// (for comparison).
+    #[arg(long)]
+    pub(crate) no_reversed_draw: bool,
 }
 
 impl ModelArgs {
@@ -318,6 +322,7 @@ impl ModelArgs {
             said_colours: self.said_colours,
             redraws: self.redraws,
             redraw_temperature: self.redraw_temperature,
+            reversed_draw: !self.no_reversed_draw,
             ..PlanOptions::default()
         }
     }

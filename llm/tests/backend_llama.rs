@@ -234,6 +234,44 @@ fn a_shared_prefix_is_saved_to_disk_and_a_new_backend_reads_it_back() {
 }
 
 #[test]
+fn two_long_prefixes_taking_turns_in_a_small_cache_are_kept_on_disk() {
+    let _g = serial();
+    let Some(path) = model(SMOL) else { return };
+    let dir = std::env::temp_dir().join(format!("ivlmap-prompt-turns-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    // Room for one of the two prefixes at a time: each request evicts the other's slot.
+    let mut cfg = LlamaCppConfig::new(&path);
+    cfg.n_ctx = 2048;
+    cfg.prompt_cache_dir = Some(dir.clone());
+    let backend = LlamaCppBackend::new(cfg).unwrap();
+    let p = few_shot_prefix().repeat(2);
+    let q: String = p.lines().rev().collect::<Vec<_>>().join("\n");
+    let (p1, q1, p2, q2, p3) = (
+        ask(&p, "Instruction: go to the second red chair.", 8),
+        ask(&q, "Instruction: go to the second red chair.", 8),
+        ask(&p, "Instruction: face the white counter.", 8),
+        ask(&q, "Instruction: face the white counter.", 8),
+        ask(&p, "Instruction: stop by the bed.", 8),
+    );
+    let first = backend.complete(&p1).unwrap();
+    assert!(first.prompt_tokens > 1000, "{first:?}");
+    backend.complete(&q1).unwrap();
+    assert!(snapshots(&dir).is_empty(), "no prompt was asked twice yet");
+    // The first prefix again: evicted, so evaluated again, then written to disk.
+    let again = backend.complete(&p2).unwrap();
+    assert!(again.cached_prompt_tokens < 100, "{again:?}");
+    assert_eq!(snapshots(&dir).len(), 1);
+    backend.complete(&q2).unwrap();
+    assert_eq!(snapshots(&dir).len(), 2);
+    // The third time, the first prefix is read back from disk.
+    let third = backend.complete(&p3).unwrap();
+    assert!(third.cached_prompt_tokens > 1000, "{third:?}");
+    assert_eq!(snapshots(&dir).len(), 2, "nothing new to save");
+    drop(backend);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn grammar_forces_the_answer_set() {
     let _g = serial();
     let Some(b) = smol(2048) else { return };

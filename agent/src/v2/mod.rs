@@ -7,7 +7,8 @@
 //! ([`answer`]), held by a grammar built for this map ([`grammar`]). The plan is typed
 //! ([`planner_dsl::typed::TypedPlan`]); [`check`] compares it with the instruction's
 //! words, the objects line and the map, and a dry run runs it. A disagreement gets one
-//! targeted re-ask naming it; if the second answer still disagrees the person gets a
+//! targeted re-ask naming it, then the first request with its worked examples reversed
+//! and a sampled draw of the re-ask; if none of them passes the person gets a
 //! question (or a refusal, for an object the map does not hold). No rule edits the
 //! model's answer: the plan that runs is the one the model wrote, printed canonically.
 
@@ -312,8 +313,49 @@ fn reask_vocabulary(
     Some(v)
 }
 
-/// Plans one instruction with one model call (and at most one re-ask, then
-/// [`crate::PlanOptions::redraws`] sampled draws of the re-ask's request).
+/// One answer drawn for an instruction (see [`plan_instruction`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Draw {
+    /// The request, greedy.
+    First,
+    /// The request with what the checks found added, greedy, under the re-ask's grammar.
+    Reask,
+    /// The first request with the worked examples in reverse order, greedy, under the
+    /// re-ask's grammar ([`crate::PlanOptions::reversed_draw`]).
+    Reversed,
+    /// The re-ask's request (the first with `reask` off) sampled with this seed.
+    Sampled(u32),
+}
+
+/// The answers drawn, in order, until the checks accept one.
+fn draws(o: &crate::PlanOptions) -> Vec<Draw> {
+    let mut d = vec![Draw::First];
+    if o.reask {
+        d.push(Draw::Reask);
+    }
+    if o.reversed_draw {
+        d.push(Draw::Reversed);
+    }
+    d.extend((1..=o.redraws).map(Draw::Sampled));
+    d
+}
+
+/// `msgs` (the system message, the worked examples as request and answer pairs, then
+/// the request) with the worked examples in reverse order.
+fn reversed_examples(msgs: &[ChatMessage]) -> Vec<ChatMessage> {
+    let mut m = msgs.to_vec();
+    let n = m.len();
+    if n > 3 {
+        let pairs: Vec<ChatMessage> = m[1..n - 1].to_vec();
+        let rev: Vec<ChatMessage> = pairs.chunks(2).rev().flatten().cloned().collect();
+        m.splice(1..n - 1, rev);
+    }
+    m
+}
+
+/// Plans one instruction with one model call (and at most one re-ask, then the answer
+/// with the worked examples reversed and [`crate::PlanOptions::redraws`] sampled draws
+/// of the re-ask's request, each judged by the checks as the first is).
 ///
 /// # Errors
 /// [`LanguageError`]: prompts or backend. A plan that does not settle is an
@@ -349,26 +391,31 @@ pub fn plan_instruction(
         )
     };
     let (mut grammar, mut lark) = grammar_of(&vocab);
+    let reversed = reversed_examples(&msgs);
     let known = check::colours_of(ctx.map, &ctx.references);
     let mut timing = Timing::default();
     let mut attempts = Vec::new();
     let mut findings = Vec::new();
-    // Greedy rounds: the answer, then (with `reask`) the re-ask. Then the redraws: the
-    // last greedy request sampled, one seed each (see `PlanOptions::redraws`).
-    let greedy_rounds = u32::from(ctx.options.reask);
-    let last_round = greedy_rounds + ctx.options.redraws;
-    for round in 0..=last_round {
-        let mut req = CompletionRequest::new(msgs.clone(), ctx.options.plan_max_tokens);
+    let draws = draws(&ctx.options);
+    for (round, draw) in draws.iter().enumerate() {
+        let round = u32::try_from(round).unwrap_or(u32::MAX);
+        let mut req = CompletionRequest::new(
+            match draw {
+                Draw::Reversed => reversed.clone(),
+                _ => msgs.clone(),
+            },
+            ctx.options.plan_max_tokens,
+        );
         req.grammar.clone_from(&grammar);
         req.lark.clone_from(&lark);
-        if round > greedy_rounds {
+        if let Draw::Sampled(seed) = draw {
             req.temperature = ctx.options.redraw_temperature;
-            req.seed = Some(round - greedy_rounds);
+            req.seed = Some(*seed);
         }
         let c = backend.complete(&req)?;
         timing.add(&c);
         attempts.push(c.text.clone());
-        match assess(&c.text, instruction, ctx) {
+        let f = match assess(&c.text, instruction, ctx) {
             Ok(a) => {
                 timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
                 return Ok(Outcome::Plan(Box::new(PlannedInstruction {
@@ -381,16 +428,13 @@ pub fn plan_instruction(
                     attempts,
                 })));
             }
-            Err(f) if round == last_round => {
+            Err(f) => f,
+        };
+        match draws.get(round as usize + 1) {
+            None => {
                 tracing::debug!(round, answer = %c.text, findings = ?f, "answer still disagrees");
-                findings = f;
             }
-            Err(f) if round >= greedy_rounds => {
-                // The re-ask's request again, drawn with the next seed.
-                tracing::debug!(round, answer = %c.text, findings = ?f, "answer disagrees; drawing again");
-                findings = f;
-            }
-            Err(f) => {
+            Some(Draw::Reask) => {
                 tracing::debug!(round, answer = %c.text, findings = ?f, "answer disagrees; re-asking once");
                 // The re-ask is the same request with what the checks found added to it
                 // (measured: with the first answer left in the conversation, the model
@@ -405,9 +449,12 @@ pub fn plan_instruction(
                 {
                     (grammar, lark) = grammar_of(&v);
                 }
-                findings = f;
+            }
+            Some(_) => {
+                tracing::debug!(round, answer = %c.text, findings = ?f, "answer disagrees; drawing again");
             }
         }
+        findings = f;
     }
     Ok(settle(&findings))
 }

@@ -118,9 +118,10 @@ fn reask_replays_from_a_recorded_cassette() {
     let label = judge(&res, &map);
     println!("{label}");
     // One request, at most one re-ask (the same request with what the checks found
-    // appended to its last message; the first answer is not replayed to the model), and
-    // at most one redraw (the default): the re-ask's request, sampled with seed 1.
-    assert!((1..=3).contains(&records.len()), "{}", records.len());
+    // appended to its last message; the first answer is not replayed to the model), the
+    // first request with its worked examples reversed (greedy), and at most one redraw
+    // (the default): the re-ask's request, sampled with seed 1.
+    assert!((1..=4).contains(&records.len()), "{}", records.len());
     let first = &records[0].request.messages;
     assert_eq!(first.last().unwrap().role, Role::User);
     assert!(first.last().unwrap().content.ends_with(INSTRUCTION));
@@ -137,18 +138,28 @@ fn reask_replays_from_a_recorded_cassette() {
     }
     if let Some(third) = records.get(2) {
         let (second, third) = (&records[1].request, &third.request);
-        assert_eq!(third.messages, second.messages);
+        let n = first.len();
+        assert_eq!(third.messages.len(), n);
+        assert_eq!(third.messages[0], first[0]);
+        assert_eq!(third.messages[n - 1], first[n - 1]);
+        assert_eq!(third.messages[1], first[n - 3]);
         assert_eq!(third.lark, second.lark);
-        assert!(third.temperature > 0.0 && second.temperature == 0.0);
-        assert_eq!(third.seed, Some(1));
+        assert!(third.temperature == 0.0 && third.seed.is_none());
+    }
+    if let Some(fourth) = records.get(3) {
+        let (second, fourth) = (&records[1].request, &fourth.request);
+        assert_eq!(fourth.messages, second.messages);
+        assert_eq!(fourth.lark, second.lark);
+        assert!(fourth.temperature > 0.0 && second.temperature == 0.0);
+        assert_eq!(fourth.seed, Some(1));
     }
     // The outcome matches how many answers were recorded.
     match &res {
         Ok(Outcome::Plan(p)) => assert_eq!(records.len(), p.attempts.len()),
         _ => assert_eq!(
             records.len(),
-            3,
-            "a question comes after the re-ask and the redraw"
+            4,
+            "a question comes after the re-ask, the reversed examples' answer and the redraw"
         ),
     }
 }
