@@ -449,7 +449,6 @@ fn worker_main(cfg: LlamaCppConfig, ready: SyncSender<Result<(), LlmError>>, rx:
         } else {
             None
         },
-        recent: Vec::new(),
     };
     if ready.send(Ok(())).is_err() {
         return;
@@ -489,15 +488,7 @@ struct Worker<'m> {
     llg: Option<llguidance::ParserFactory>,
     /// The prompt cache on disk, when configured.
     disk: Option<DiskCache>,
-    /// The last [`RECENT_PROMPTS`] prompts (tokens), newest last: a prompt sharing a long
-    /// prefix with one of them that no slot holds any more (the slots' cells were needed
-    /// for other prefixes in between) is written to disk after its evaluation, so that
-    /// two prefixes taking turns do not both have to be evaluated again each time.
-    recent: Vec<Vec<LlamaToken>>,
 }
-
-/// How many recent prompts [`Worker::recent`] remembers.
-const RECENT_PROMPTS: usize = 8;
 
 /// The slot for a prompt and the length of the prefix it already holds: the slot with the
 /// longest common prefix, if that prefix is worth keeping (at least half of the slot's
@@ -828,20 +819,9 @@ impl Worker<'_> {
         let prompt_ms = t_prompt.elapsed().as_secs_f64() * 1e3;
         // A long prefix shared with a recent prompt that the KV cache no longer held (this
         // request evaluated it again): the slot now holds the whole prompt; keep it on disk.
-        if self.disk.is_some() {
-            let shared = self
-                .recent
-                .iter()
-                .map(|r| disk_cache::common_prefix(r, &tokens))
-                .max()
-                .unwrap_or(0);
-            if shared >= keep + disk_cache::MIN_TOKENS {
-                self.save_to_disk(slot, seq, &tokens);
-            }
-            self.recent.push(tokens.clone());
-            if self.recent.len() > RECENT_PROMPTS {
-                self.recent.remove(0);
-            }
+        let shared = self.disk.as_mut().map_or(0, |d| d.asked_before(&tokens));
+        if shared >= keep + disk_cache::MIN_TOKENS {
+            self.save_to_disk(slot, seq, &tokens);
         }
 
         let t_gen = Instant::now();

@@ -19,8 +19,12 @@
 //!
 //! What is saved: when a request reuses at least [`MIN_TOKENS`] tokens of a slot (the
 //! prefix two requests shared) and no entry already covers that prefix, the slot's
-//! sequence holds exactly that prefix at that moment, and it is written. At most
-//! [`MAX_ENTRIES`] entries per model are kept, the oldest removed first.
+//! sequence holds exactly that prefix at that moment, and it is written. Also when a
+//! request shares at least [`MIN_TOKENS`] more tokens with one of the last
+//! [`RECENT_PROMPTS`] prompts ([`DiskCache::asked_before`]) than its slot still held (the
+//! slots' cells went to other prefixes in between, as two long prefixes taking turns in a
+//! small KV cache do): the slot then holds the whole prompt just evaluated, and that is
+//! written. At most [`MAX_ENTRIES`] entries per model are kept, the oldest removed first.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -33,6 +37,9 @@ pub const MIN_TOKENS: usize = 512;
 
 /// Entries kept per model.
 pub const MAX_ENTRIES: usize = 8;
+
+/// Prompts remembered by [`DiskCache::asked_before`].
+pub const RECENT_PROMPTS: usize = 8;
 
 /// One saved prefix.
 #[derive(Debug, Clone)]
@@ -54,6 +61,8 @@ impl Entry {
 pub struct DiskCache {
     dir: PathBuf,
     entries: Vec<Entry>,
+    /// The last [`RECENT_PROMPTS`] prompts of this process, newest last.
+    recent: Vec<Vec<LlamaToken>>,
 }
 
 /// The folder name for a model evaluated under `settings`: its file name, size and
@@ -128,7 +137,11 @@ impl DiskCache {
             }
         }
         entries.sort_by(|a, b| a.kv.cmp(&b.kv));
-        Some(Self { dir, entries })
+        Some(Self {
+            dir,
+            entries,
+            recent: Vec::new(),
+        })
     }
 
     /// The entry sharing the longest prefix with `tokens`, and that length, if at least
@@ -151,6 +164,22 @@ impl DiskCache {
             && self
                 .best(tokens)
                 .is_none_or(|(_, have)| have + MIN_TOKENS <= n)
+    }
+
+    /// The longest prefix `tokens` shares with one of the last [`RECENT_PROMPTS`] prompts
+    /// passed here (0 for none); then remembers `tokens`.
+    pub fn asked_before(&mut self, tokens: &[LlamaToken]) -> usize {
+        let shared = self
+            .recent
+            .iter()
+            .map(|r| common_prefix(r, tokens))
+            .max()
+            .unwrap_or(0);
+        self.recent.push(tokens.to_vec());
+        if self.recent.len() > RECENT_PROMPTS {
+            self.recent.remove(0);
+        }
+        shared
     }
 
     /// A fresh path for a new snapshot (`<n>.kv`, `n` past every entry's).
@@ -258,6 +287,25 @@ mod tests {
         let longer = toks((0..550).chain(1000..1100).chain(5000..6000));
         assert!(c.wants(&longer, 1200));
         assert!(!c.wants(&toks(0..400), 400));
+        let _ = fs::remove_dir_all(&root);
+    }
+
+    #[test]
+    fn prompts_asked_before_are_remembered_up_to_a_limit() {
+        let root = tempdir("recent");
+        let model = root.join("m.gguf");
+        fs::write(&model, b"x").unwrap();
+        let mut c = DiskCache::open(&root, &model, "t2-b512").unwrap();
+        assert_eq!(c.asked_before(&toks(0..600)), 0);
+        assert_eq!(c.asked_before(&toks((0..550).chain(900..950))), 550);
+        for k in 0..RECENT_PROMPTS as i32 {
+            c.asked_before(&toks((0..10).map(|i| i + 10_000 * (k + 1))));
+        }
+        assert_eq!(
+            c.asked_before(&toks(0..600)),
+            0,
+            "forgotten after the limit"
+        );
         let _ = fs::remove_dir_all(&root);
     }
 
