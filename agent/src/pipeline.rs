@@ -148,6 +148,13 @@ pub struct PlanContext<'a> {
     /// Object ids the conversation visited, which a v2 plan may name with
     /// `get_instance` (see [`crate::Session::references`]).
     pub references: Vec<u32>,
+    /// An instruction this one may answer: the conversation's last, which got a
+    /// question or a refusal instead of a plan ([`crate::Session::not_done`]). Its words
+    /// count as said for what a plan may select on (colours, counts, orders, rooms: the
+    /// grammar's narrowing and the checks of what the person did not say), never as
+    /// asked for ("i meant the two red ones" after "the two black chairs" need not be
+    /// black).
+    pub earlier: Option<String>,
     /// Knobs.
     pub options: PlanOptions,
 }
@@ -163,6 +170,7 @@ impl<'a> PlanContext<'a> {
             pose: map.start_pose,
             history: None,
             references: Vec::new(),
+            earlier: None,
             options: PlanOptions::default(),
         }
     }

@@ -39,11 +39,23 @@ pub struct Turn {
     pub error: Option<String>,
 }
 
+/// An instruction the session answered with a question or a refusal instead of a plan.
+/// The person's next words are often the answer to it ("oh sorry, I meant the two red
+/// ones", "the black one then"), which mean nothing without it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Unanswered {
+    /// What the person said.
+    pub instruction: String,
+    /// The question (or refusal) they got.
+    pub reply: String,
+}
+
 /// A conversation with the robot.
 #[derive(Debug, Clone)]
 pub struct Session {
     start: Pose,
     turns: Vec<Turn>,
+    unanswered: Option<Unanswered>,
 }
 
 impl Session {
@@ -53,7 +65,24 @@ impl Session {
         Self {
             start,
             turns: Vec::new(),
+            unanswered: None,
         }
+    }
+
+    /// Records that `instruction` got `reply`, a question or a refusal, instead of a
+    /// plan: until a plan runs, the next instruction is planned as a possible answer to
+    /// it (see [`Session::references`] and [`PlanContext::earlier`]).
+    pub fn not_done(&mut self, instruction: &str, reply: &str) {
+        self.unanswered = Some(Unanswered {
+            instruction: instruction.to_string(),
+            reply: reply.to_string(),
+        });
+    }
+
+    /// The last instruction that got a question or a refusal, if no plan ran since.
+    #[must_use]
+    pub fn unanswered(&self) -> Option<&Unanswered> {
+        self.unanswered.as_ref()
     }
 
     /// The turns so far.
@@ -64,10 +93,12 @@ impl Session {
 
     /// The conversation as named references for v2's request: where the session
     /// started, then each visited instance, most recent last, with its id, e.g.
-    /// `start: [1.0, 1.0]; visited: table 17 (yellow) in turn 1, sofa 2 (black) in turn 2`.
+    /// `start: [1.0, 1.0]; visited: table 17 (yellow) in turn 1, sofa 2 (black) in turn 2`;
+    /// then the last instruction that got a question or a refusal, if no plan ran since
+    /// ([`Session::not_done`]). `None` before anything was said.
     #[must_use]
     pub fn references(&self, map: &IvlMap) -> Option<String> {
-        if self.turns.is_empty() {
+        if self.turns.is_empty() && self.unanswered.is_none() {
             return None;
         }
         let p = self.start.position;
@@ -85,8 +116,11 @@ impl Session {
                 }
             }
         }
-        let last = self.turns.last().map(|t| t.end_pose).unwrap_or_default();
-        Some(format!(
+        let last = self
+            .turns
+            .last()
+            .map_or_else(|| self.start.to_array(), |t| t.end_pose);
+        let mut s = format!(
             "we started at [{:.1}, {:.1}]; you are at [{:.1}, {:.1}]; visited so far: {}",
             p.x,
             p.y,
@@ -97,13 +131,21 @@ impl Session {
             } else {
                 visited.join(", ")
             }
-        ))
+        );
+        if let Some(u) = &self.unanswered {
+            s.push_str(&format!(
+                "; not done: the person said \"{}\" and you answered \"{}\"",
+                u.instruction, u.reply
+            ));
+        }
+        Some(s)
     }
 
     /// Plans the next instruction in the light of the conversation: the session's
     /// references (see [`Session::references`]) go into the request unless `ctx`
-    /// carries a history of its own, and the instances visited so far may be named by
-    /// id in the plan; then [`plan_instruction`].
+    /// carries a history of its own, the instances visited so far may be named by id in
+    /// the plan, and an instruction left unanswered ([`Session::not_done`]) is
+    /// [`PlanContext::earlier`] unless `ctx` has one; then [`plan_instruction`].
     ///
     /// # Errors
     /// As [`plan_instruction`].
@@ -117,6 +159,9 @@ impl Session {
         let mut ctx = ctx.clone();
         if ctx.history.is_none() {
             ctx.history = self.references(ctx.map);
+        }
+        if ctx.earlier.is_none() {
+            ctx.earlier = self.unanswered.as_ref().map(|u| u.instruction.clone());
         }
         for t in &self.turns {
             for id in &t.visited {
@@ -147,6 +192,7 @@ impl Session {
                 _ => None,
             })
             .collect();
+        self.unanswered = None;
         self.turns.push(Turn {
             instruction: planned.instruction.clone(),
             tuples: planned.tuples.clone(),

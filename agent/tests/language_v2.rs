@@ -13,13 +13,14 @@ use std::sync::{Arc, Mutex};
 
 use agent::v2::answer::parse_answer;
 use agent::v2::grammar::Vocabulary;
-use agent::{plan_instruction, Outcome, PlanContext, PlanSource, Prompts};
+use agent::{plan_instruction, Outcome, PlanContext, PlanSource, Prompts, Session};
 use llm::{
     Completion, CompletionRequest, FinishReason, LlamaCppBackend, LlamaCppConfig, LlmBackend,
     LlmError, Role,
 };
 use map_core::{IvlMap, Scene, SimRobot};
 use planner_dsl::typed::TypedPlan;
+use planner_dsl::Limits;
 
 fn flat_a() -> Arc<IvlMap> {
     let path = concat!(
@@ -235,6 +236,47 @@ fn redraws_sample_the_reask_again_and_the_checks_judge_each() {
     let out = plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
     assert!(matches!(out, Outcome::Question(_)), "{out:?}");
     assert_eq!(b.requests().len(), 5);
+}
+
+#[test]
+fn the_reply_to_a_question_is_planned_with_the_instruction_it_answers() {
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let ctx = v2(&map, &robot);
+    let prompts = Prompts::builtin();
+    let mut session = Session::new(map.start_pose);
+    // flat-a has no purple sofa, whatever the model says four times.
+    let purple = "objects: [(sofa, None, purple)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"purple\"}));\n";
+    let first = "please go to the purple sofa";
+    let b = Scripted::new(&[purple; 4]);
+    let q = match session.plan(&b, &prompts, first, &ctx).unwrap() {
+        Outcome::Question(q) => q,
+        other => panic!("expected a question, got {other:?}"),
+    };
+    assert_eq!(session.references(&map), None, "nothing was said before");
+    session.not_done(first, &q);
+    assert_eq!(session.unanswered().unwrap().instruction, first);
+
+    // The reply's request carries the instruction it answers and the question.
+    let reply = "hm ok, the black one then";
+    let b = Scripted::new(&[BLACK_SOFA_RIGHT]);
+    let p = session
+        .plan(&b, &prompts, reply, &ctx)
+        .unwrap()
+        .plan()
+        .cloned()
+        .expect("the black sofa");
+    let last = b.requests()[0].messages.last().unwrap().content.clone();
+    assert!(
+        last.contains(first) && last.contains(&q) && last.ends_with(reply),
+        "{last}"
+    );
+
+    // A plan that runs settles it: later requests no longer carry it.
+    let mut robot = SimRobot::new(map.clone());
+    session.execute(&p, &map, &mut robot, &Limits::default());
+    assert!(session.unanswered().is_none());
+    assert!(!session.references(&map).unwrap().contains(first));
 }
 
 #[test]

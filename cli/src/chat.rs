@@ -306,10 +306,13 @@ impl Chat {
             Outcome::Plan(p) => p,
             Outcome::Question(q) => {
                 let _ = writeln!(out, "? {q}");
+                // The next line may answer it.
+                self.session.not_done(instr, &q);
                 return Ok(());
             }
             Outcome::Refusal(r) => {
                 let _ = writeln!(out, "cannot do that: {r}");
+                self.session.not_done(instr, &r);
                 return Ok(());
             }
         };

@@ -84,7 +84,11 @@ pub fn run_dialogue(
                     out.error.map(|e| e.to_string()),
                 )
             }
-            Ok(Outcome::Question(q) | Outcome::Refusal(q)) => (None, None, Some(q), None),
+            Ok(Outcome::Question(q) | Outcome::Refusal(q)) => {
+                // The next turn may be the person's answer to it.
+                session.not_done(&turn.say, &q);
+                (None, None, Some(q), None)
+            }
             Err(e) => (None, None, None, Some(e.to_string())),
         };
         let tr = robot.trajectory();

@@ -509,6 +509,8 @@ async fn answer(
     let planned = match outcome {
         Outcome::Plan(p) => p,
         Outcome::Question(q) => {
+            // The next instruction may answer it.
+            e.state().chat.not_done(text, &q);
             return Ok(InstructionReply::without_plan(
                 text,
                 Kind::Question,
@@ -516,9 +518,10 @@ async fn answer(
                 &st.service.map.name,
                 pose,
                 stops + 1,
-            ))
+            ));
         }
         Outcome::Refusal(r) => {
+            e.state().chat.not_done(text, &r);
             return Ok(InstructionReply::without_plan(
                 text,
                 Kind::Refused,
@@ -526,7 +529,7 @@ async fn answer(
                 &st.service.map.name,
                 pose,
                 stops + 1,
-            ))
+            ));
         }
     };
     e.emit(

@@ -793,6 +793,26 @@ pub(crate) fn unsaid_colours<'a>(
     out
 }
 
+/// The words that count as said for what a plan may select on: `instruction`'s, after
+/// those of the `earlier` instruction it may answer ([`check_answer_after`]).
+pub(crate) fn said_before(instruction: &str, earlier: Option<&str>) -> String {
+    match earlier {
+        Some(e) => format!("{e}\n{instruction}"),
+        None => instruction.to_string(),
+    }
+}
+
+/// The colours that count as said besides the instruction's own words: those of the
+/// instances `refs` (what the conversation visited), and the colour words of the
+/// `earlier` instruction this one may answer ([`check_answer_after`]).
+pub(crate) fn known_colours(map: &IvlMap, refs: &[u32], earlier: Option<&str>) -> Vec<String> {
+    let mut known = colours_of(map, refs);
+    if let Some(e) = earlier {
+        known.extend(words(e).into_iter().filter_map(|w| normalise_colour(&w)));
+    }
+    known
+}
+
 /// The colours of the instances `refs` (what the conversation visited), which count as
 /// said ([`colour_said`]'s `known`).
 pub(crate) fn colours_of(map: &IvlMap, refs: &[u32]) -> Vec<String> {
@@ -1110,11 +1130,31 @@ pub fn check_answer(
     visited: &[u32],
     refs: &[u32],
 ) -> Vec<Finding> {
+    check_answer_after(map, instruction, None, tuples, plan, pose, visited, refs)
+}
+
+/// [`check_answer`] for an instruction that may answer an `earlier` one, which got a
+/// question or a refusal instead of a plan (`PlanContext::earlier`): the earlier words
+/// count as said for what a plan may select on (colours, counts, orders, rooms), never
+/// as asked for, so what the person asks is still read from `instruction` alone.
+#[must_use]
+#[allow(clippy::too_many_arguments)] // check_answer's, and the one instruction before
+pub fn check_answer_after(
+    map: &IvlMap,
+    instruction: &str,
+    earlier: Option<&str>,
+    tuples: &[Tuple],
+    plan: &TypedPlan,
+    pose: Pose,
+    visited: &[u32],
+    refs: &[u32],
+) -> Vec<Finding> {
     let mut out = check_tuples(map, instruction, tuples, plan, pose, visited, refs);
     out.extend(check_names(map, instruction, plan, pose, visited, refs));
     out.extend(check_words(map, instruction, plan, pose, visited));
-    let known = colours_of(map, refs);
-    out.extend(check_unsaid_colours(map, instruction, &known, plan, pose));
+    let known = known_colours(map, refs, earlier);
+    let allowed = said_before(instruction, earlier);
+    out.extend(check_unsaid_colours(map, &allowed, &known, plan, pose));
     let in_chat = !refs.is_empty();
     // What a selection may say only when the person's words do: each with the re-ask's
     // note and the question's words after "which <name> do you mean".
@@ -1136,14 +1176,14 @@ pub fn check_answer(
     };
     let unsaid: [(Vec<&Target>, &Note, &str); 5] = [
         (
-            unsaid_directions(instruction, plan),
+            unsaid_directions(&allowed, plan),
             &directions,
             ", counting from where",
         ),
-        (unsaid_sizes(instruction, plan), &sizes, ""),
-        (unsaid_far_ends(instruction, plan), &far_ends, ""),
-        (unsaid_regions(instruction, in_chat, plan), &regions, ""),
-        (unsaid_ordinals(instruction, plan), &ordinals, ""),
+        (unsaid_sizes(&allowed, plan), &sizes, ""),
+        (unsaid_far_ends(&allowed, plan), &far_ends, ""),
+        (unsaid_regions(&allowed, in_chat, plan), &regions, ""),
+        (unsaid_ordinals(&allowed, plan), &ordinals, ""),
     ];
     for (targets, to_model, how) in unsaid {
         out.extend(unsaid_findings(map, pose, targets, to_model, |t| {
@@ -1229,6 +1269,67 @@ pub(crate) mod tests {
                 .any(|x| x.kind == FindingKind::Word && x.to_model.contains(says)),
             "{instruction}: {f:?}"
         );
+    }
+
+    /// The findings on a plan of one move to `object` picked with `select`, for
+    /// `instruction` as a possible answer to `earlier`.
+    fn findings_after(
+        earlier: &str,
+        instruction: &str,
+        object: &str,
+        select: &str,
+    ) -> Vec<Finding> {
+        let m = map();
+        let a = parse_answer(&format!(
+            "objects: [({object}, None, None)]\nplan:\nmove_to_object(get_obj(\"{object}\", {select}));"
+        ))
+        .unwrap();
+        check_answer_after(
+            &m,
+            instruction,
+            Some(earlier),
+            &a.tuples,
+            &a.plan,
+            m.start_pose,
+            &[],
+            &[],
+        )
+    }
+
+    #[test]
+    fn the_words_of_an_earlier_instruction_count_as_said_never_as_asked() {
+        // "sorry, the one by the tv" after "the black sofa by the window" got a question:
+        // the black sofa is what the person said, so its colour is no made-up one...
+        let pick = "#{colour: \"black\", near: get_obj(\"tv\")}";
+        let unsaid = |f: &[Finding]| f.iter().any(|x| x.to_model.contains("did not say"));
+        assert!(unsaid(&findings_for_pick(
+            "sorry, the one by the tv",
+            "sofa",
+            pick
+        )));
+        let f = findings_after(
+            "take me to the black sofa by the window",
+            "sorry, the one by the tv",
+            "sofa",
+            pick,
+        );
+        assert!(!unsaid(&f), "{f:?}");
+        // ...and so is a count ("the second chair", then "the black one").
+        let pick = "#{ordinal: 2, colour: \"black\"}";
+        let counted = |f: &[Finding]| f.iter().any(|x| x.to_model.contains("no such count"));
+        assert!(counted(&findings_for_pick("the black one", "chair", pick)));
+        let f = findings_after("go to the second chair", "the black one", "chair", pick);
+        assert!(!counted(&f) && !unsaid(&f), "{f:?}");
+        // But what the earlier words asked for is not asked now: "i meant the red one"
+        // after "the black sofa" wants no black.
+        let f = findings_after(
+            "go to the black sofa",
+            "oh sorry, i meant the red one",
+            "sofa",
+            "#{colour: \"red\"}",
+        );
+        assert!(f.iter().all(|x| !x.to_model.contains("black")), "{f:?}");
+        assert!(f.is_empty(), "{f:?}");
     }
 
     #[test]

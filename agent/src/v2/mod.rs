@@ -30,7 +30,7 @@ use crate::prompts::Prompts;
 use crate::tuples::{parse_tuples, Tuple};
 
 use self::answer::{objects_part, parse_answer, Answer};
-use self::check::{check_answer, runtime_finding, Finding, FindingKind};
+use self::check::{check_answer_after, runtime_finding, Finding, FindingKind};
 use self::grammar::{
     answer_grammar, answer_lark, name_groups, objects_grammar, objects_lark, Vocabulary,
 };
@@ -153,9 +153,10 @@ fn assess(text: &str, instruction: &str, ctx: &PlanContext<'_>) -> Result<Accept
             }
         }
     }
-    let mut found = check_answer(
+    let mut found = check_answer_after(
         ctx.map,
         instruction,
+        ctx.earlier.as_deref(),
         &answer.tuples,
         &answer.plan,
         pose,
@@ -380,7 +381,11 @@ pub fn plan_instruction(
         v.ids.clone_from(&ctx.references);
         v.comments = quotes_words(prompts.example_index()?.examples());
         if ctx.options.said_only {
-            narrow_to_words(&mut v, instruction, ctx);
+            narrow_to_words(
+                &mut v,
+                &check::said_before(instruction, ctx.earlier.as_deref()),
+                ctx,
+            );
         }
         v
     };
@@ -392,7 +397,7 @@ pub fn plan_instruction(
     };
     let (mut grammar, mut lark) = grammar_of(&vocab);
     let reversed = reversed_examples(&msgs);
-    let known = check::colours_of(ctx.map, &ctx.references);
+    let known = check::known_colours(ctx.map, &ctx.references, ctx.earlier.as_deref());
     let mut timing = Timing::default();
     let mut attempts = Vec::new();
     let mut findings = Vec::new();
@@ -595,7 +600,7 @@ mod tests {
     /// The checks' findings on `answer` to `instruction`, a first answer on `m`.
     fn first_findings(m: &map_core::IvlMap, instruction: &str, answer: &str) -> Vec<Finding> {
         let a = parse_answer(answer).unwrap();
-        check_answer(m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[])
+        check::check_answer(m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[])
     }
 
     #[test]
