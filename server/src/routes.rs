@@ -509,8 +509,6 @@ async fn answer(
     let planned = match outcome {
         Outcome::Plan(p) => p,
         Outcome::Question(q) => {
-            // The next instruction may answer it.
-            e.state().chat.not_done(text, &q);
             return Ok(InstructionReply::without_plan(
                 text,
                 Kind::Question,
@@ -521,7 +519,6 @@ async fn answer(
             ));
         }
         Outcome::Refusal(r) => {
-            e.state().chat.not_done(text, &r);
             return Ok(InstructionReply::without_plan(
                 text,
                 Kind::Refused,
