@@ -516,7 +516,7 @@ async fn answer(
                 &st.service.map.name,
                 pose,
                 stops + 1,
-            ));
+            ))
         }
         Outcome::Refusal(r) => {
             return Ok(InstructionReply::without_plan(
@@ -526,7 +526,7 @@ async fn answer(
                 &st.service.map.name,
                 pose,
                 stops + 1,
-            ));
+            ))
         }
     };
     e.emit(
