@@ -147,7 +147,8 @@ impl Server {
         self.run_until(std::future::pending()).await
     }
 
-    /// Serves until `shutdown` completes, then finishes the requests in flight.
+    /// Serves until `shutdown` completes, then finishes the requests in flight and the
+    /// model jobs already running (those still waiting are dropped unrun).
     ///
     /// # Errors
     /// [`ServeError::Io`] when serving fails.
@@ -172,7 +173,7 @@ impl Server {
             }
         });
         let closing = state.closing.clone();
-        let app = crate::routes::router(state);
+        let app = crate::routes::router(state.clone());
         let served = axum::serve(self.listener, app)
             .with_graceful_shutdown(async move {
                 shutdown.await;
@@ -180,6 +181,9 @@ impl Server {
             })
             .await;
         sweeper.abort();
+        // A job whose requester timed out may still be running on a model thread: wait
+        // for it, so that the process never exits while llama.cpp computes.
+        let _ = tokio::task::spawn_blocking(move || state.queue.shutdown()).await;
         served.map_err(ServeError::Io)
     }
 }

@@ -2,11 +2,15 @@
 //! number of worker threads (one for a local model, which answers one request at a
 //! time). Each waiting job hears its position whenever it changes, so the page can show
 //! it. Jobs run on plain threads (the backends are synchronous); a job whose requester
-//! has gone is dropped unrun, and a job that panics loses only itself.
+//! has gone is dropped unrun, and a job that panics loses only itself. Shutting the queue
+//! down ([`ModelQueue::shutdown`], or dropping it) waits for the running jobs: a process
+//! that exits while llama.cpp computes on another thread dies with SIGSEGV in its
+//! kernels (seen under gdb in the server's API test, whose requester had timed out).
 
 use std::collections::VecDeque;
 use std::panic::AssertUnwindSafe;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::thread::JoinHandle;
 
 /// A unit of work for a worker.
 pub type Job = Box<dyn FnOnce() + Send + 'static>;
@@ -48,12 +52,18 @@ impl Inner {
     }
 }
 
-/// The queue is full.
+/// Why a job was not queued.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[error("{waiting} instruction(s) are already waiting for the model; try again shortly")]
-pub struct QueueFull {
-    /// How many were waiting.
-    pub waiting: usize,
+pub enum QueueError {
+    /// The queue is full.
+    #[error("{waiting} instruction(s) are already waiting for the model; try again shortly")]
+    Full {
+        /// How many were waiting.
+        waiting: usize,
+    },
+    /// The queue has been shut down (the server is stopping).
+    #[error("the server is shutting down and takes no more instructions")]
+    Closed,
 }
 
 /// How busy the queue is.
@@ -71,11 +81,12 @@ pub struct QueueStats {
     pub dropped: u64,
 }
 
-/// A first-come-first-served queue in front of `workers` threads. Dropping it lets the
-/// threads finish what they hold and exit.
+/// A first-come-first-served queue in front of `workers` threads. Dropping it shuts it
+/// down ([`ModelQueue::shutdown`]).
 pub struct ModelQueue {
     inner: Arc<Inner>,
     workers: usize,
+    threads: Mutex<Vec<JoinHandle<()>>>,
 }
 
 impl std::fmt::Debug for ModelQueue {
@@ -98,24 +109,42 @@ impl ModelQueue {
             max_waiting: max_waiting.max(1),
         });
         let workers = workers.max(1);
+        let mut threads = Vec::with_capacity(workers);
         for k in 0..workers {
-            let inner = inner.clone();
-            std::thread::Builder::new()
+            let shared = inner.clone();
+            let spawned = std::thread::Builder::new()
                 .name(format!("ivlmap-model-{k}"))
-                .spawn(move || work(&inner))?;
+                .spawn(move || work(&shared));
+            match spawned {
+                Ok(t) => threads.push(t),
+                Err(e) => {
+                    // Those already started see the queue closed and exit.
+                    inner.lock().closed = true;
+                    inner.ready.notify_all();
+                    return Err(e);
+                }
+            }
         }
-        Ok(Self { inner, workers })
+        Ok(Self {
+            inner,
+            workers,
+            threads: Mutex::new(threads),
+        })
     }
 
     /// Queues `job`; `position` hears where it stands (now, and at every change) and
     /// `wanted` is asked just before it runs.
     ///
     /// # Errors
-    /// [`QueueFull`] when `max_waiting` jobs wait already.
-    pub fn push(&self, job: Job, position: PositionFn, wanted: WantedFn) -> Result<(), QueueFull> {
+    /// [`QueueError::Full`] when `max_waiting` jobs wait already, [`QueueError::Closed`]
+    /// after [`ModelQueue::shutdown`].
+    pub fn push(&self, job: Job, position: PositionFn, wanted: WantedFn) -> Result<(), QueueError> {
         let mut st = self.inner.lock();
+        if st.closed {
+            return Err(QueueError::Closed);
+        }
         if st.waiting.len() >= self.inner.max_waiting {
-            return Err(QueueFull {
+            return Err(QueueError::Full {
                 waiting: st.waiting.len(),
             });
         }
@@ -142,12 +171,43 @@ impl ModelQueue {
             dropped: st.dropped,
         }
     }
+
+    /// Takes no more jobs, drops the waiting ones unrun (their requesters see their answer
+    /// channel close), and waits until the running ones have finished and the threads
+    /// have exited. A second call returns at once. It blocks: call it off the async
+    /// runtime. Called from one of the queue's own threads (a job holding the last
+    /// reference), it waits for the others only.
+    pub fn shutdown(&self) {
+        let unrun = {
+            let mut st = self.inner.lock();
+            st.closed = true;
+            let unrun = std::mem::take(&mut st.waiting);
+            st.dropped += unrun.len() as u64;
+            unrun
+        };
+        self.inner.ready.notify_all();
+        // Outside the lock: dropping a job runs its captures' destructors.
+        drop(unrun);
+        let threads = std::mem::take(
+            &mut *self
+                .threads
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner),
+        );
+        let me = std::thread::current().id();
+        for t in threads {
+            if t.thread().id() != me {
+                // A job's panic is caught inside the thread: join only fails on a panic
+                // in the queue's own code, which has nothing left to clean up.
+                let _ = t.join();
+            }
+        }
+    }
 }
 
 impl Drop for ModelQueue {
     fn drop(&mut self) {
-        self.inner.lock().closed = true;
-        self.inner.ready.notify_all();
+        self.shutdown();
     }
 }
 
@@ -290,9 +350,54 @@ mod tests {
         let err = q
             .push(Box::new(|| {}), Box::new(|_| {}), Box::new(|| true))
             .unwrap_err();
-        assert_eq!(err.waiting, 1);
+        assert_eq!(err, QueueError::Full { waiting: 1 });
         gate_tx.send(()).unwrap();
         assert_eq!(rx.recv_timeout(Duration::from_secs(10)).unwrap(), 1);
         assert_eq!(rx.recv_timeout(Duration::from_secs(10)).unwrap(), 2);
+    }
+
+    #[test]
+    fn shutdown_waits_for_the_running_job_and_drops_the_waiting() {
+        let q = Arc::new(ModelQueue::new(1, 8).unwrap());
+        let (gate_tx, gate_rx) = mpsc::channel::<()>();
+        let gate = Mutex::new(gate_rx);
+        let finished = Arc::new(Mutex::new(Vec::<u8>::new()));
+        let f = finished.clone();
+        q.push(
+            Box::new(move || {
+                let _ = gate.lock().unwrap().recv_timeout(Duration::from_secs(10));
+                f.lock().unwrap().push(1);
+            }),
+            Box::new(|_| {}),
+            Box::new(|| true),
+        )
+        .unwrap();
+        wait_until(|| q.stats().running == 1);
+        let f = finished.clone();
+        q.push(
+            Box::new(move || f.lock().unwrap().push(2)),
+            Box::new(|_| {}),
+            Box::new(|| true),
+        )
+        .unwrap();
+        // The gate opens only once shutdown has dropped the waiting job: the running one
+        // is still running while shutdown waits.
+        let opener = {
+            let q = q.clone();
+            std::thread::spawn(move || {
+                wait_until(|| q.stats().dropped == 1);
+                gate_tx.send(()).unwrap();
+            })
+        };
+        q.shutdown();
+        assert_eq!(*finished.lock().unwrap(), vec![1]);
+        let s = q.stats();
+        assert_eq!((s.served, s.dropped, s.waiting, s.running), (1, 1, 0, 0));
+        let err = q
+            .push(Box::new(|| {}), Box::new(|_| {}), Box::new(|| true))
+            .unwrap_err();
+        assert_eq!(err, QueueError::Closed);
+        q.shutdown();
+        opener.join().unwrap();
     }
 }

@@ -509,6 +509,8 @@ async fn answer(
     let planned = match outcome {
         Outcome::Plan(p) => p,
         Outcome::Question(q) => {
+            // The next instruction may answer it.
+            e.state().chat.not_done(text, &q);
             return Ok(InstructionReply::without_plan(
                 text,
                 Kind::Question,
@@ -516,9 +518,10 @@ async fn answer(
                 &st.service.map.name,
                 pose,
                 stops + 1,
-            ))
+            ));
         }
         Outcome::Refusal(r) => {
+            e.state().chat.not_done(text, &r);
             return Ok(InstructionReply::without_plan(
                 text,
                 Kind::Refused,
@@ -526,7 +529,7 @@ async fn answer(
                 &st.service.map.name,
                 pose,
                 stops + 1,
-            ))
+            ));
         }
     };
     e.emit(
@@ -590,9 +593,13 @@ async fn plan(
             .ok()
             .is_some_and(|s| s.as_ref().is_some_and(|s| !s.is_closed()))
     });
-    st.queue
-        .push(job, position, wanted)
-        .map_err(|full| ApiError::new(StatusCode::SERVICE_UNAVAILABLE, "busy", full.to_string()))?;
+    st.queue.push(job, position, wanted).map_err(|e| {
+        let code = match e {
+            crate::queue::QueueError::Full { .. } => "busy",
+            crate::queue::QueueError::Closed => "shutting_down",
+        };
+        ApiError::new(StatusCode::SERVICE_UNAVAILABLE, code, e.to_string())
+    })?;
     let left = st.config.request_timeout.saturating_sub(started.elapsed());
     match tokio::time::timeout(left, rx).await {
         Ok(Ok(Ok(outcome))) => Ok(outcome),
