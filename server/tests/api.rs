@@ -505,6 +505,30 @@ async fn instructions_preview_confirm_undo_and_events() {
 async fn load_50_sessions_by_4_instructions() {
     let Some(rec) = recorded() else { return };
     let _g = SERIAL.lock().await;
+    // An instruction that got a question stays in the session's conversation: the
+    // request for the next one names it (SmolLM2's answers are mostly questions).
+    let asked: Vec<String> = std::fs::read_to_string(&rec.cassette)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| serde_json::from_str::<llm::replay::CassetteRecord>(l).unwrap())
+        .flat_map(|r| r.request.messages.into_iter().map(|m| m.content))
+        .collect();
+    let mut questions = 0;
+    for (k, seq) in rec.replies.iter().enumerate() {
+        for (i, (st, v)) in seq.iter().enumerate().take(SEQUENCES[k].len() - 1) {
+            if *st == StatusCode::OK && v["outcome"] == "question" {
+                questions += 1;
+                let said = format!("not done: the person said \"{}\"", SEQUENCES[k][i]);
+                assert!(
+                    asked.iter().any(|c| c.contains(&said)),
+                    "no request after the question to {:?} names it",
+                    SEQUENCES[k][i]
+                );
+            }
+        }
+    }
+    println!("{questions} recorded question(s) named in the next instruction's request");
     const SESSIONS: usize = 50;
     let s = start(
         Service::new(flat_a(), replay(rec)),
