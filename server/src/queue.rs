@@ -109,27 +109,25 @@ impl ModelQueue {
             max_waiting: max_waiting.max(1),
         });
         let workers = workers.max(1);
-        let mut threads = Vec::with_capacity(workers);
-        for k in 0..workers {
-            let shared = inner.clone();
-            let spawned = std::thread::Builder::new()
-                .name(format!("ivlmap-model-{k}"))
-                .spawn(move || work(&shared));
-            match spawned {
-                Ok(t) => threads.push(t),
-                Err(e) => {
-                    // Those already started see the queue closed and exit.
-                    inner.lock().closed = true;
-                    inner.ready.notify_all();
-                    return Err(e);
-                }
-            }
-        }
-        Ok(Self {
+        // Built first, so that when a thread cannot be started, dropping it shuts down
+        // those already started.
+        let queue = Self {
             inner,
             workers,
-            threads: Mutex::new(threads),
-        })
+            threads: Mutex::new(Vec::with_capacity(workers)),
+        };
+        for k in 0..workers {
+            let inner = queue.inner.clone();
+            let thread = std::thread::Builder::new()
+                .name(format!("ivlmap-model-{k}"))
+                .spawn(move || work(&inner))?;
+            queue
+                .threads
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .push(thread);
+        }
+        Ok(queue)
     }
 
     /// Queues `job`; `position` hears where it stands (now, and at every change) and
@@ -266,22 +264,11 @@ mod tests {
     #[test]
     fn first_come_first_served_with_positions() {
         let q = ModelQueue::new(1, 8).unwrap();
-        let (gate_tx, gate_rx) = mpsc::channel::<()>();
-        let gate = Mutex::new(gate_rx);
         let (done_tx, done_rx) = mpsc::channel::<usize>();
         let positions = Arc::new(Mutex::new(Vec::<(usize, Option<usize>)>::new()));
         // Job 0 holds the only worker until the gate opens.
         let d = done_tx.clone();
-        q.push(
-            Box::new(move || {
-                let _ = gate.lock().unwrap().recv_timeout(Duration::from_secs(10));
-                d.send(0).unwrap();
-            }),
-            Box::new(|_| {}),
-            Box::new(|| true),
-        )
-        .unwrap();
-        wait_until(|| q.stats().running == 1);
+        let gate_tx = hold_the_worker(&q, move || d.send(0).unwrap());
         for k in 1..=3 {
             let d = done_tx.clone();
             let p = positions.clone();
@@ -308,6 +295,24 @@ mod tests {
         assert_eq!((s.served, s.dropped, s.waiting, s.running), (3, 1, 0, 0));
     }
 
+    /// Queues a job that holds a worker until the returned gate opens (or 10 s pass),
+    /// then runs `then`; returns once it runs.
+    fn hold_the_worker(q: &ModelQueue, then: impl FnOnce() + Send + 'static) -> mpsc::Sender<()> {
+        let (gate_tx, gate_rx) = mpsc::channel::<()>();
+        let gate = Mutex::new(gate_rx);
+        q.push(
+            Box::new(move || {
+                let _ = gate.lock().unwrap().recv_timeout(Duration::from_secs(10));
+                then();
+            }),
+            Box::new(|_| {}),
+            Box::new(|| true),
+        )
+        .unwrap();
+        wait_until(|| q.stats().running == 1);
+        gate_tx
+    }
+
     fn wait_until(what: impl Fn() -> bool) {
         let t0 = std::time::Instant::now();
         while !what() {
@@ -327,19 +332,8 @@ mod tests {
         )
         .unwrap();
         wait_until(|| q.stats().served == 1);
-        let (gate_tx, gate_rx) = mpsc::channel::<()>();
-        let gate = Mutex::new(gate_rx);
         let t = tx.clone();
-        q.push(
-            Box::new(move || {
-                let _ = gate.lock().unwrap().recv_timeout(Duration::from_secs(10));
-                t.send(1).unwrap();
-            }),
-            Box::new(|_| {}),
-            Box::new(|| true),
-        )
-        .unwrap();
-        wait_until(|| q.stats().running == 1);
+        let gate_tx = hold_the_worker(&q, move || t.send(1).unwrap());
         let t = tx.clone();
         q.push(
             Box::new(move || t.send(2).unwrap()),
@@ -359,20 +353,9 @@ mod tests {
     #[test]
     fn shutdown_waits_for_the_running_job_and_drops_the_waiting() {
         let q = Arc::new(ModelQueue::new(1, 8).unwrap());
-        let (gate_tx, gate_rx) = mpsc::channel::<()>();
-        let gate = Mutex::new(gate_rx);
         let finished = Arc::new(Mutex::new(Vec::<u8>::new()));
         let f = finished.clone();
-        q.push(
-            Box::new(move || {
-                let _ = gate.lock().unwrap().recv_timeout(Duration::from_secs(10));
-                f.lock().unwrap().push(1);
-            }),
-            Box::new(|_| {}),
-            Box::new(|| true),
-        )
-        .unwrap();
-        wait_until(|| q.stats().running == 1);
+        let gate_tx = hold_the_worker(&q, move || f.lock().unwrap().push(1));
         let f = finished.clone();
         q.push(
             Box::new(move || f.lock().unwrap().push(2)),
