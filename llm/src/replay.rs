@@ -165,6 +165,11 @@ impl ReplayBackend {
         self.records.is_empty()
     }
 
+    /// The recorded exchanges, in the cassette's order.
+    pub fn records(&self) -> impl Iterator<Item = &CassetteRecord> {
+        self.records.iter().map(|(_, r)| r)
+    }
+
     fn miss(&self, req: &CompletionRequest) -> LlmError {
         let detail = match self
             .records

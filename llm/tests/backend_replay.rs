@@ -73,6 +73,8 @@ fn record_then_replay_round_trip() {
 
     let replay = ReplayBackend::open(&cassette).unwrap();
     assert_eq!(replay.len(), 2);
+    let asked: Vec<&CompletionRequest> = replay.records().map(|r| &r.request).collect();
+    assert_eq!(asked, [&req("go to the sofa"), &req("go to the bed")]);
     assert_eq!(replay.name(), "replay");
     assert_eq!(replay.model(), "remote-model");
     let c = replay.complete(&req("go to the bed")).unwrap();

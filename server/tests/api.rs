@@ -508,12 +508,10 @@ async fn load_50_sessions_by_4_instructions() {
     // An instruction that got a question stays in the session's conversation: the
     // request for the next one names it, where that one was answered (under the
     // recording's load most instructions time out in the queue, unasked).
-    let asked: Vec<String> = std::fs::read_to_string(&rec.cassette)
-        .unwrap()
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| serde_json::from_str::<llm::replay::CassetteRecord>(l).unwrap())
-        .flat_map(|r| r.request.messages.into_iter().map(|m| m.content))
+    let cassette = ReplayBackend::open(&rec.cassette).unwrap();
+    let asked: Vec<&str> = cassette
+        .records()
+        .flat_map(|r| r.request.messages.iter().map(|m| m.content.as_str()))
         .collect();
     let mut questions = 0;
     for (k, seq) in rec.replies.iter().enumerate() {
