@@ -240,8 +240,12 @@ fn objects_rules(w: &mut Writer, map_colours: &[String], map_names: &[String]) {
     colours.extend(map_colours.iter().cloned());
     colours.retain(|c| !c.trim().is_empty());
     // Empty when the person names no object ("turn around", "go back to where we
-    // started").
-    w.rule("objects", "\"objects: [\" (tuple (\", \" tuple)*)? \"]\"");
+    // started"); at most 16 objects, as many as a plan's statements, so that a weak model
+    // that repeats a tuple stops (SmolLM2 listed `(desk, 1, None)` to the token limit).
+    w.rule(
+        "objects",
+        "\"objects: [\" (tuple (\", \" tuple){0,15})? \"]\"",
+    );
     w.rule(
         "tuple",
         "\"(\" tword \", \" tordinal \", \" tcolour (\", \" torder)? \")\"",
@@ -1019,6 +1023,16 @@ pub(crate) mod tests {
             &["colour: \"red\", other_than: get_instance(9)"],
             &["other_than: get_instance(9)"],
         );
+    }
+
+    #[test]
+    fn the_objects_line_holds_at_most_sixteen_tuples() {
+        let lark = answer_lark(&vocab());
+        let plan = "\nplan:\nmove_to_object(get_obj(\"chair\"));";
+        let line = |n: usize| vec!["(desk, 1, None)"; n].join(", ");
+        lark_accepts(&lark, &format!("objects: [{}]{plan}", line(16))).unwrap();
+        assert!(lark_accepts(&lark, &format!("objects: [{}]{plan}", line(17))).is_err());
+        lark_accepts(&lark, &format!("objects: []{plan}")).unwrap();
     }
 
     #[test]
