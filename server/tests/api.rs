@@ -401,7 +401,7 @@ async fn instructions_preview_confirm_undo_and_events() {
         println!("SKIPPED: none of SmolLM2's recorded answers ran; this test needs a plan");
         return;
     };
-    let s = start(Service::new(flat_a(), replay(rec)), local()).await;
+    let s = start(smol_service(replay(rec)), local()).await;
     let api = s.api();
     let id = api.session().await;
     // The sequence up to it, as recorded.
@@ -531,7 +531,7 @@ async fn load_50_sessions_by_4_instructions() {
     println!("{questions} recorded question(s) named in the next instruction's request");
     const SESSIONS: usize = 50;
     let s = start(
-        Service::new(flat_a(), replay(rec)),
+        smol_service(replay(rec)),
         ServeConfig {
             workers: 4,
             ..local()

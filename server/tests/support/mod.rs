@@ -88,10 +88,24 @@ pub async fn start(service: Service, config: ServeConfig) -> Running {
     }
 }
 
-/// A server on flat-a answering with `backend` on one worker.
+/// The service that SmolLM2's recording and every replay of it answer with: flat-a, the
+/// built-in prompts, and answers cut at 96 tokens (a replay must send the very requests
+/// that were recorded, so both use this).
+///
+/// Each of [`SEQUENCES`]' instructions names one place, and a right answer to one is 30 to
+/// 60 tokens. SmolLM2-135M often repeats a step until the limit: at the default 384 tokens,
+/// about 45 ms a token and up to four draws an instruction, one such instruction held the
+/// one worker for minutes, and 13 of 16 recorded instructions ended in 503 `timeout`.
+pub fn smol_service(backend: Arc<dyn LlmBackend>) -> Service {
+    let mut service = Service::new(flat_a(), backend);
+    service.options.plan_max_tokens = 96;
+    service
+}
+
+/// A server answering with [`smol_service`] on one worker.
 pub async fn one_worker(backend: Arc<dyn LlmBackend>) -> Running {
     start(
-        Service::new(flat_a(), backend),
+        smol_service(backend),
         ServeConfig {
             workers: 1,
             ..local()
