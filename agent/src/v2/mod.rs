@@ -83,9 +83,13 @@ pub fn extract(
     );
     req.stop = vec!["\n".into()];
     if options.answer_grammar {
-        req.grammar = Some(objects_grammar());
+        let mut vocab = Vocabulary::default();
+        if options.said_only {
+            narrow_orders(&mut vocab, instruction);
+        }
+        req.grammar = Some(objects_grammar(&vocab));
         if options.llguidance {
-            req.lark = Some(objects_lark());
+            req.lark = Some(objects_lark(&vocab));
         }
     }
     let c = backend.complete(&req)?;
@@ -226,6 +230,13 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
         let said = check::region_said(instruction);
         v.region_keys = Some(v.regions.iter().filter(|r| said(r)).cloned().collect());
     }
+    narrow_orders(v, instruction);
+}
+
+/// Offers directional orders only when `instruction` names a direction, orders by size
+/// only when it speaks of size, `far_to_near` only when it speaks of the far end: in the
+/// selections and in the objects line.
+fn narrow_orders(v: &mut Vocabulary, instruction: &str) {
     v.no_directions = !check::direction_said(instruction);
     v.no_sizes = !check::size_said(instruction);
     v.no_far_end = !check::far_end_said(instruction);
