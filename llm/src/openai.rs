@@ -513,6 +513,7 @@ fn parse_completion(url: &str, body: &str, elapsed_ms: f64) -> Result<Completion
         generate_ms,
         finish_reason,
         forced_tokens: 0,
+        drafted_tokens: 0,
     })
 }
 
