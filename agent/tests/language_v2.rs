@@ -76,7 +76,6 @@ impl LlmBackend for Scripted {
             generate_ms: 0.0,
             finish_reason: FinishReason::Stop,
             forced_tokens: 0,
-            drafted_tokens: 0,
         })
     }
 }

@@ -238,11 +238,6 @@ pub(crate) struct ModelArgs {
     /// answer may then depend on what the prompt cache held.
     #[arg(long, value_enum, value_name = "WHEN", default_value = "auto")]
     pub(crate) flash_attention: FlashAttention,
-    /// llama: speculative decoding by prompt lookup: each step decodes up to N tokens
-    /// that followed the same few tokens earlier in the prompt or answer, and keeps those
-    /// the model would have chosen (0: off).
-    #[arg(long, value_name = "N")]
-    pub(crate) draft: Option<u32>,
     /// llama: folder of the prompt cache on disk (snapshots of long prompt prefixes read
     /// back by later runs; default ~/.cache/ivlmap/prompt-cache).
     #[arg(long, conflicts_with = "no_prompt_cache")]
@@ -308,7 +303,6 @@ impl ModelArgs {
                 FlashAttention::Auto => None,
             },
             send_grammar: self.send_grammar,
-            draft_tokens: self.draft,
             prompt_cache: if self.no_prompt_cache {
                 None
             } else {

@@ -46,9 +46,6 @@ pub struct BackendChoice {
     pub send_grammar: bool,
     /// llama: the prompt cache's folder on disk (`None`: off).
     pub prompt_cache: Option<PathBuf>,
-    /// llama: tokens drafted by prompt lookup per decoding step
-    /// ([`LlamaCppConfig::draft_tokens`]; `None`: the backend's default).
-    pub draft_tokens: Option<u32>,
 }
 
 /// `~/.cache/ivlmap/prompt-cache` (`None` without a home folder).
@@ -91,9 +88,6 @@ pub fn open_backend(choice: &BackendChoice) -> Result<Box<dyn LlmBackend>, LlmEr
                 cfg.threads = t.max(1);
             }
             cfg.flash_attention = choice.flash_attention;
-            if let Some(n) = choice.draft_tokens {
-                cfg.draft_tokens = n;
-            }
             cfg.prompt_cache_dir.clone_from(&choice.prompt_cache);
             Box::new(LlamaCppBackend::new(cfg)?)
         }

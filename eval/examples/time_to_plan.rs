@@ -6,7 +6,7 @@
 //! cargo run --release -p eval --example time_to_plan -- \
 //!     --model ~/.cache/ivlmap/models/qwen2.5-coder-1.5b-instruct-q4_k_m.gguf \
 //!     [--threads 2] [--limit 24] [--uncached-limit 6] \
-//!     [--suite examples/suites/flat-a.nav.jsonl]... [--fast-forward-side | --draft-side N]
+//!     [--suite examples/suites/flat-a.nav.jsonl]... [--fast-forward-side]
 //! ```
 //!
 //! Instructions: every clause of the navigation suites' tasks ("go to the second white
@@ -20,9 +20,7 @@
 //!
 //! With `--fast-forward-side` the second backend keeps the prefix cache and fast-forwards
 //! the grammar's forced tokens instead (`LlamaCppConfig::fast_forward`), every instruction
-//! on both sides. With `--draft-side N` the second backend keeps the prefix cache and
-//! drafts up to N tokens a step by prompt lookup (`LlamaCppConfig::draft_tokens`), every
-//! instruction on both sides.
+//! on both sides.
 //!
 //! Output: one JSON line per plan on stdout, then a Markdown table of p50/p95 per kind
 //! and cache mode, with mean prompt tokens, cached prompt tokens, LLM calls and how many
@@ -155,12 +153,8 @@ struct Args {
     suites: Vec<PathBuf>,
     /// Compare fast-forward instead of the prefix cache: the second side keeps the
     /// prefix cache and decodes the grammar's forced tokens in one batch.
-    #[arg(long, conflicts_with = "draft_side")]
+    #[arg(long)]
     fast_forward_side: bool,
-    /// Compare speculative decoding instead of the prefix cache: the second side keeps
-    /// the prefix cache and drafts up to N tokens a step by prompt lookup.
-    #[arg(long, value_name = "N")]
-    draft_side: Option<u32>,
 }
 
 fn main() -> Result<(), BoxError> {
@@ -171,7 +165,6 @@ fn main() -> Result<(), BoxError> {
         uncached_limit,
         mut suites,
         fast_forward_side,
-        draft_side,
     } = clap::Parser::parse();
     if suites.is_empty() {
         for s in ["flat-a", "office-b", "house-c"] {
@@ -206,19 +199,16 @@ fn main() -> Result<(), BoxError> {
     let cached = LlamaCppBackend::new(cfg.clone())?;
     if fast_forward_side {
         cfg.fast_forward = true;
-    } else if let Some(n) = draft_side {
-        cfg.draft_tokens = n;
     } else {
         cfg.prefix_cache = false;
         cfg.n_slots = 1;
     }
     let uncached = LlamaCppBackend::new(cfg)?;
-    let other = match (fast_forward_side, draft_side) {
-        (true, _) => "fast-forward".to_string(),
-        (false, Some(n)) => format!("{n} tokens drafted"),
-        (false, None) => "prefix cache off".to_string(),
+    let other = if fast_forward_side {
+        "fast-forward"
+    } else {
+        "prefix cache off"
     };
-    let both_sides_all = fast_forward_side || draft_side.is_some();
     let prompts = Prompts::builtin();
 
     // Warm-up: the first instruction of a chat session fills the cache with the shared
@@ -244,7 +234,7 @@ fn main() -> Result<(), BoxError> {
         for (n, (i, instruction)) in list.iter().enumerate() {
             let t = &tasks[*i];
             let robot = SimRobot::with_pose(t.map.clone(), t.start);
-            let with_off = both_sides_all || n < uncached_limit;
+            let with_off = fast_forward_side || n < uncached_limit;
             let order: &[bool] = if n % 2 == 0 {
                 &[true, false]
             } else {

@@ -227,10 +227,6 @@ pub struct Completion {
     /// instead of sampled one by one (llama with a Lark grammar; 0 elsewhere).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub forced_tokens: u32,
-    /// Of the generated tokens, how many were drafted by prompt lookup and kept, decoded
-    /// in a batch with the token before them (llama with `draft_tokens`; 0 elsewhere).
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub drafted_tokens: u32,
 }
 
 #[allow(clippy::trivially_copy_pass_by_ref)] // serde's skip_serializing_if passes a reference

@@ -35,13 +35,11 @@ use llama_cpp_2::model::params::LlamaModelParams;
 use llama_cpp_2::model::{LlamaChatMessage, LlamaChatTemplate, LlamaModel};
 use llama_cpp_2::sampling::LlamaSampler;
 use llama_cpp_2::token::LlamaToken;
-use llama_cpp_2::vocab::LlamaVocab;
 use llama_cpp_2::{ChatTemplateError, LogOptions};
 
 use super::{ChatMessage, Completion, CompletionRequest, FinishReason, LlmBackend, LlmError, Role};
 
 mod disk_cache;
-mod lookup;
 use self::disk_cache::DiskCache;
 
 /// The template used when a model carries none (llama.cpp's built-in ChatML).
@@ -87,19 +85,6 @@ pub struct LlamaCppConfig {
     /// correct plan; with it, the time to plan is the same as sampling (one subgoal p50
     /// 4.92 s against 5.08 s, `time_to_plan --fast-forward-side`), so it stays off.
     pub fast_forward: bool,
-    /// Speculative decoding by prompt lookup: after each token, up to this many tokens
-    /// that followed the context's last 2 to 4 tokens where they occurred before
-    /// ([`lookup::draft`]) are decoded with it in one batch, and kept for as long as each
-    /// is what the sampler chain (the grammar included) picks from the logits before it;
-    /// the first one that is not is replaced by the pick, the rest dropped from the KV
-    /// cache. Each token is still sampled once, from its own logits and with the same
-    /// random draws, so the answer is the one sampled token by token, up to the batch's
-    /// different floating-point sums. 0 (the default): off. Ignored with
-    /// [`Self::fast_forward`]. Measured on 2 cores with the default model, 2 drafted
-    /// (`time_to_plan --draft-side 2`): 0.93x the time per generated token and 5 of 20
-    /// plans moved by those sums; a batch costs about as much per token as one token
-    /// there (README, "Time to plan").
-    pub draft_tokens: u32,
     /// A folder for the prompt cache on disk: snapshots of long prompt prefixes (at least
     /// 512 tokens shared by two requests) that a later process reads back instead of
     /// evaluating them again, at most 8 per model. `None` (the default): nothing is
@@ -133,7 +118,6 @@ impl LlamaCppConfig {
             chat_template: None,
             prefix_cache: true,
             fast_forward: false,
-            draft_tokens: 0,
             n_slots: 4,
             ignore_eos: false,
             prompt_cache_dir: None,
@@ -841,220 +825,109 @@ impl Worker<'_> {
         }
 
         let t_gen = Instant::now();
-        let mut answer = Emitted {
-            out: Vec::new(),
-            n_gen: 0,
-            max_new,
-            max_stop: req.stop.iter().map(String::len).max().unwrap_or(0),
-            stops: &req.stop,
-            ignore_eos: self.cfg.ignore_eos,
-        };
+        let max_stop = req.stop.iter().map(String::len).max().unwrap_or(0);
+        let mut out: Vec<u8> = Vec::new();
+        let mut n_gen = 0usize;
         let mut n_forced = 0usize;
-        let mut n_drafted = 0usize;
         let mut pos = tokens.len();
-        let drafting = self.cfg.draft_tokens > 0 && !self.cfg.fast_forward;
-        // What prompt lookup searches: the prompt and every token taken so far.
-        let mut context: Vec<LlamaToken> = if drafting { tokens.clone() } else { Vec::new() };
-        let finish = 'gen: loop {
-            if answer.n_gen >= max_new {
+        let finish = loop {
+            if n_gen >= max_new {
                 break FinishReason::Length;
             }
             // `sample` also accepts the token into every sampler of the chain (grammar
             // included); accepting it again would corrupt the grammar state.
-            let mut tok = sampler.sample(&self.ctx, last_idx);
-            // Each pass: `tok` is sampled and not yet decoded.
-            loop {
-                if let Some(end) = answer.take(&vocab, tok, follower.as_mut())? {
-                    break 'gen end;
+            let tok = sampler.sample(&self.ctx, last_idx);
+            if !self.cfg.ignore_eos && vocab.is_eog(tok) {
+                break FinishReason::Stop;
+            }
+            n_gen += 1;
+            let before = out.len();
+            out.extend_from_slice(&vocab.token_to_piece(tok, false, None));
+            if let Some(cut) = find_stop(&out, before, max_stop, &req.stop) {
+                out.truncate(cut);
+                break FinishReason::Stop;
+            }
+            if n_gen >= max_new {
+                break FinishReason::Length;
+            }
+            // Fast-forward: the tokens the grammar forces after this one are not sampled
+            // one by one; they join this token in one batch.
+            // llama-cpp-2's token environment is not a canonical tokenizer, so llguidance
+            // gives the forced bytes; they are tokenized here with the model's vocabulary.
+            let mut forced: Vec<LlamaToken> = Vec::new();
+            // (A matcher that has finished its grammar takes no more tokens; the sampler's
+            // own matcher skips them too.)
+            if let Some(m) = follower
+                .as_mut()
+                .filter(|m| m.is_error() || !m.is_stopped())
+            {
+                if m.consume_token(tok.0.cast_unsigned()).is_err() {
+                    let why = m.get_error().unwrap_or_default();
+                    let why = why.lines().next().unwrap_or_default();
+                    return Err(LlmError::GrammarNotHeld {
+                        after_bytes: out.len(),
+                        reason: why.to_string(),
+                    });
                 }
-                if drafting {
-                    context.push(tok);
-                }
-                // Fast-forward: the tokens the grammar forces after this one are not
-                // sampled one by one; they join this token in one batch.
-                // llama-cpp-2's token environment is not a canonical tokenizer, so
-                // llguidance gives the forced bytes; they are tokenized here with the
-                // model's vocabulary.
-                let mut forced: Vec<LlamaToken> = Vec::new();
                 if self.cfg.fast_forward {
-                    // (A matcher that has finished its grammar takes no more tokens.)
-                    if let Some(m) = follower.as_mut().filter(|m| !m.is_stopped()) {
-                        let room = (max_new - answer.n_gen).min(n_batch.saturating_sub(1));
-                        let bytes = m.compute_ff_bytes();
-                        if !bytes.is_empty() {
-                            forced = vocab.tokenize(&bytes, false, false);
-                            // The last token of the forced bytes may be one the model
-                            // would merge with what follows (`("` before `sofa`, Qwen's
-                            // BPE joins punctuation runs): it is held back and sampled, so
-                            // every token boundary fast-forwarded is one the forced text
-                            // itself ends.
-                            forced.pop();
-                            forced.truncate(room);
-                            let ids: Vec<u32> =
-                                forced.iter().map(|t| t.0.cast_unsigned()).collect();
-                            // Only the forced tokens the grammar takes as tokenized here
-                            // go ahead; the rest are sampled.
-                            let taken = m.try_consume_tokens(&ids).unwrap_or(0);
-                            forced.truncate(taken);
-                        }
+                    let room = (max_new - n_gen).min(n_batch.saturating_sub(1));
+                    let bytes = m.compute_ff_bytes();
+                    if !bytes.is_empty() {
+                        forced = vocab.tokenize(&bytes, false, false);
+                        // The last token of the forced bytes may be one the model would
+                        // merge with what follows (`("` before `sofa`, Qwen's BPE joins
+                        // punctuation runs): it is held back and sampled, so every token
+                        // boundary fast-forwarded is one the forced text itself ends.
+                        forced.pop();
+                        forced.truncate(room);
+                        let ids: Vec<u32> = forced.iter().map(|t| t.0.cast_unsigned()).collect();
+                        // Only the forced tokens the grammar takes as tokenized here go
+                        // ahead; the rest are sampled.
+                        let taken = m.try_consume_tokens(&ids).unwrap_or(0);
+                        forced.truncate(taken);
                     }
                 }
-                // Speculation: tokens that followed the same few tokens earlier in the
-                // context, checked below against what the chain samples.
-                let draft = if drafting {
-                    let room = (max_new - answer.n_gen)
-                        .saturating_sub(1)
-                        .min(n_batch.saturating_sub(1))
-                        .min(self.cfg.draft_tokens as usize);
-                    lookup::draft(&context, 4, 2, room)
-                } else {
-                    Vec::new()
-                };
-                batch.clear();
-                let step: Vec<LlamaToken> = std::iter::once(tok)
-                    .chain(forced.iter().copied())
-                    .chain(draft.iter().copied())
-                    .collect();
-                for (j, &t) in step.iter().enumerate() {
-                    // A draft needs the logits at every position it is checked at.
-                    let logits = j + 1 == step.len() || !draft.is_empty();
-                    add(&mut batch, t, pos + j, seq, logits)?;
-                }
-                self.decode(&mut batch)?;
-                if let Some(s) = self.slots.get_mut(slot) {
-                    s.tokens.extend_from_slice(&step);
-                }
-                pos += step.len();
-                last_idx = batch.n_tokens() - 1;
-                for &t in &forced {
-                    sampler.accept(t);
-                    n_forced += 1;
-                    if answer.push(&vocab, t) {
-                        break 'gen FinishReason::Stop;
-                    }
-                }
-                if draft.is_empty() {
+            }
+            batch.clear();
+            let step: Vec<LlamaToken> =
+                std::iter::once(tok).chain(forced.iter().copied()).collect();
+            for (j, &t) in step.iter().enumerate() {
+                add(&mut batch, t, pos + j, seq, j + 1 == step.len())?;
+            }
+            self.decode(&mut batch)?;
+            if let Some(s) = self.slots.get_mut(slot) {
+                s.tokens.extend_from_slice(&step);
+            }
+            pos += step.len();
+            last_idx = batch.n_tokens() - 1;
+            let mut stopped = false;
+            for &t in &step[1..] {
+                sampler.accept(t);
+                n_gen += 1;
+                n_forced += 1;
+                let before = out.len();
+                out.extend_from_slice(&vocab.token_to_piece(t, false, None));
+                if let Some(cut) = find_stop(&out, before, max_stop, &req.stop) {
+                    out.truncate(cut);
+                    stopped = true;
                     break;
                 }
-                // Check the draft: the chain samples at `tok`'s logits, then at each
-                // draft token's for as long as it sampled that token. The first sample
-                // that differs is the next token; what was drafted after it is dropped.
-                let mut kept = 0;
-                let next = loop {
-                    let t = sampler.sample(&self.ctx, i32::try_from(kept).unwrap_or(0));
-                    if draft.get(kept) != Some(&t) {
-                        break t;
-                    }
-                    kept += 1;
-                    n_drafted += 1;
-                    if let Some(end) = answer.take(&vocab, t, follower.as_mut())? {
-                        break 'gen end;
-                    }
-                    context.push(t);
-                };
-                let dropped = draft.len() - kept;
-                if dropped > 0 {
-                    pos -= dropped;
-                    let cleared = u32::try_from(pos).ok().and_then(|p0| {
-                        self.ctx
-                            .clear_kv_cache_seq(Some(seq.unsigned_abs()), Some(p0), None)
-                            .ok()
-                    });
-                    if cleared != Some(true) {
-                        self.reset_cache();
-                        return Err(LlmError::Decode {
-                            message: "llama.cpp could not drop the draft tokens it rejected \
-                                      from the KV cache (a model whose memory cannot drop a \
-                                      suffix: turn speculation off)"
-                                .into(),
-                        });
-                    }
-                    if let Some(s) = self.slots.get_mut(slot) {
-                        let n = s.tokens.len() - dropped;
-                        s.tokens.truncate(n);
-                    }
-                }
-                tok = next;
+            }
+            if stopped {
+                break FinishReason::Stop;
             }
         };
         let generate_ms = t_gen.elapsed().as_secs_f64() * 1e3;
-        tracing::debug!(
-            generated = answer.n_gen,
-            forced = n_forced,
-            drafted = n_drafted,
-            generate_ms,
-            "llama: answer generated"
-        );
         Ok(Completion {
-            text: String::from_utf8_lossy(&answer.out).into_owned(),
+            text: String::from_utf8_lossy(&out).into_owned(),
             prompt_tokens: count(tokens.len()),
             cached_prompt_tokens: count(keep),
-            completion_tokens: count(answer.n_gen),
+            completion_tokens: count(n_gen),
             prompt_ms,
             generate_ms,
             finish_reason: finish,
             forced_tokens: count(n_forced),
-            drafted_tokens: count(n_drafted),
         })
-    }
-}
-
-/// An answer as it is generated: its bytes, its token count, and what ends it.
-struct Emitted<'a> {
-    out: Vec<u8>,
-    n_gen: usize,
-    max_new: usize,
-    max_stop: usize,
-    stops: &'a [String],
-    ignore_eos: bool,
-}
-
-impl Emitted<'_> {
-    /// Takes `tok`, sampled by the chain, into the answer (and into `follower`, the
-    /// grammar's copy that fast-forward asks); the reason the answer ends here, if it does.
-    fn take(
-        &mut self,
-        vocab: &LlamaVocab<'_>,
-        tok: LlamaToken,
-        follower: Option<&mut llguidance::Matcher>,
-    ) -> Result<Option<FinishReason>, LlmError> {
-        if !self.ignore_eos && vocab.is_eog(tok) {
-            return Ok(Some(FinishReason::Stop));
-        }
-        if self.push(vocab, tok) {
-            return Ok(Some(FinishReason::Stop));
-        }
-        if self.n_gen >= self.max_new {
-            return Ok(Some(FinishReason::Length));
-        }
-        // (A matcher that has finished its grammar takes no more tokens; the sampler's
-        // own matcher skips them too.)
-        if let Some(m) = follower.filter(|m| m.is_error() || !m.is_stopped()) {
-            if m.consume_token(tok.0.cast_unsigned()).is_err() {
-                let why = m.get_error().unwrap_or_default();
-                let why = why.lines().next().unwrap_or_default();
-                return Err(LlmError::GrammarNotHeld {
-                    after_bytes: self.out.len(),
-                    reason: why.to_string(),
-                });
-            }
-        }
-        Ok(None)
-    }
-
-    /// Appends `tok`'s text; whether a stop string now ends the answer (cut before it).
-    fn push(&mut self, vocab: &LlamaVocab<'_>, tok: LlamaToken) -> bool {
-        self.n_gen += 1;
-        let before = self.out.len();
-        self.out
-            .extend_from_slice(&vocab.token_to_piece(tok, false, None));
-        match find_stop(&self.out, before, self.max_stop, self.stops) {
-            Some(cut) => {
-                self.out.truncate(cut);
-                true
-            }
-            None => false,
-        }
     }
 }
 

@@ -513,7 +513,6 @@ fn parse_completion(url: &str, body: &str, elapsed_ms: f64) -> Result<Completion
         generate_ms,
         finish_reason,
         forced_tokens: 0,
-        drafted_tokens: 0,
     })
 }
 

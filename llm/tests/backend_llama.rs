@@ -349,58 +349,6 @@ fn a_lark_grammar_runs_under_llguidance_with_forced_tokens_fast_forwarded() {
 }
 
 /// `n` made-up five-letter words (a fixed sequence).
-#[test]
-fn drafted_tokens_are_kept_only_where_the_model_picks_them() {
-    let _g = serial();
-    let Some(path) = model(SMOL) else { return };
-    let backend = |draft: u32| {
-        let mut cfg = LlamaCppConfig::new(&path);
-        cfg.n_ctx = 2048;
-        cfg.prefix_cache = false;
-        cfg.draft_tokens = draft;
-        LlamaCppBackend::new(cfg).unwrap()
-    };
-    // An answer that copies from the prompt: prompt lookup drafts most of it.
-    let text = "move_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\n\
-                move_to_object(get_obj(\"chair\", #{ordinal: 3}));\n\
-                move_to_object(get_obj(\"table\", #{colour: \"yellow\"}));";
-    let mut req = ask(
-        "You copy text exactly.",
-        &format!("Copy this text exactly, and nothing else:\n{text}"),
-        64,
-    );
-    let plain = backend(0).complete(&req).unwrap();
-    assert_eq!(plain.drafted_tokens, 0);
-    let drafted = backend(4).complete(&req).unwrap();
-    assert_eq!(drafted.text, plain.text, "{drafted:?}\n{plain:?}");
-    assert_eq!(drafted.completion_tokens, plain.completion_tokens);
-    assert_eq!(drafted.finish_reason, plain.finish_reason);
-    assert!(drafted.drafted_tokens > 0, "{drafted:?}");
-
-    // Held to the text by a grammar, the model copies it, and most of the copy is drafted
-    // from the prompt and kept.
-    req.lark = Some(format!("start: {text:?}"));
-    req.max_tokens = 120;
-    let copy = backend(4).complete(&req).unwrap();
-    assert_eq!(copy.text, text, "{copy:?}");
-    assert!(copy.drafted_tokens >= 10, "{copy:?}");
-    // A drafted token the grammar refuses is never kept.
-    req.lark = Some(r#"start: "move_to_object(get_obj(\"" /[a-z]{1,8}/ "\"));""#.into());
-    let held = backend(4).complete(&req).unwrap();
-    assert!(
-        held.text.starts_with("move_to_object(get_obj(\""),
-        "{held:?}"
-    );
-    assert!(held.text.ends_with("\"));"), "{held:?}");
-    // The answer is cut at max_tokens as without drafts.
-    req.lark = None;
-    req.max_tokens = 5;
-    let cut = backend(4).complete(&req).unwrap();
-    assert_eq!(cut.completion_tokens, 5, "{cut:?}");
-    assert_eq!(cut.finish_reason, FinishReason::Length);
-    assert_eq!(cut.text, backend(0).complete(&req).unwrap().text);
-}
-
 fn made_up_words(n: usize) -> Vec<String> {
     let mut x: u32 = 12345;
     (0..n)

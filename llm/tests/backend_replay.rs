@@ -141,7 +141,6 @@ fn write_cassette(records: &[(CompletionRequest, &str)]) -> (tempfile::TempDir, 
                 generate_ms: 2.0,
                 finish_reason: llm::FinishReason::Stop,
                 forced_tokens: 0,
-                drafted_tokens: 0,
             },
         };
         s.push_str(&serde_json::to_string(&rec).unwrap());
