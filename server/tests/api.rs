@@ -506,9 +506,9 @@ async fn load_50_sessions_by_4_instructions() {
     let Some(rec) = recorded() else { return };
     let _g = SERIAL.lock().await;
     // An instruction that got a question stays in the session's conversation: the
-    // request for the next one names it, where that one was answered (under the
-    // recording's load most instructions time out in the queue, unasked).
-    let cassette = ReplayBackend::open(&rec.cassette).unwrap();
+    // request for the next one names it, where that one was answered. The cassette is
+    // read once: its requests here, its answers for the load below.
+    let cassette = Arc::new(ReplayBackend::open(&rec.cassette).unwrap());
     let asked: Vec<&str> = cassette
         .records()
         .flat_map(|r| r.request.messages.iter().map(|m| m.content.as_str()))
@@ -531,7 +531,7 @@ async fn load_50_sessions_by_4_instructions() {
     println!("{questions} recorded question(s) named in the next instruction's request");
     const SESSIONS: usize = 50;
     let s = start(
-        smol_service(replay(rec)),
+        smol_service(cassette.clone()),
         ServeConfig {
             workers: 4,
             ..local()

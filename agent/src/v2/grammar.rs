@@ -254,9 +254,8 @@ fn offered_orders(vocab: &Vocabulary, with_default: bool) -> Vec<&'static str> {
 /// counter" as `left_to_right`, "the black chair nearest the desk" with the desk
 /// `largest_to_smallest`).
 fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
-    let map_colours = &vocab.colours;
     let mut colours: Vec<String> = COLOUR_WORDS.iter().map(|s| (*s).to_string()).collect();
-    colours.extend(map_colours.iter().cloned());
+    colours.extend(vocab.colours.iter().cloned());
     colours.retain(|c| !c.trim().is_empty());
     // Empty when the person names no object ("turn around", "go back to where we
     // started"); at most 16 objects, as many as a plan's statements, so that a weak model
