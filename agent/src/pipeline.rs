@@ -113,6 +113,14 @@ pub struct PlanOptions {
     /// it as any other. Measured on held-out v2's 19 re-asked tasks (dev): README, "The
     /// language layer".
     pub reversed_draw: bool,
+    /// Each answer in two steps under the grammar (default off until judged on the
+    /// untuned sets; `--follow-objects`): the objects line, then
+    /// the plan under a grammar narrowed by that line (`v2::follow_objects`): a pick of
+    /// a name whose every tuple gives a colour selects on one of those colours, kept or
+    /// excluded. The model writes both parts; the plan's grammar holds it to its own
+    /// objects line, as the checks would. The answer is one text, the second request
+    /// continuing the first (a prefix-caching backend evaluates only the new tokens).
+    pub follow_objects: bool,
 }
 
 impl Default for PlanOptions {
@@ -130,6 +138,7 @@ impl Default for PlanOptions {
             redraws: 1,
             redraw_temperature: 0.7,
             reversed_draw: true,
+            follow_objects: false,
         }
     }
 }

@@ -83,10 +83,23 @@ impl LlmBackend for Scripted {
 /// Plans `instruction` on flat-a (a simulated robot at its start) with the model's
 /// answers fixed to `answers`; the outcome and every request made.
 fn plan_scripted(answers: &[&str], instruction: &str) -> (Outcome, Vec<CompletionRequest>) {
+    plan_scripted_with(answers, instruction, false)
+}
+
+/// [`plan_scripted`], each answer asked for in two requests when `follow_objects` is on
+/// (`PlanOptions::follow_objects`); off, in one, its grammar the whole answer's (what the
+/// tests of the re-ask's grammar read).
+fn plan_scripted_with(
+    answers: &[&str],
+    instruction: &str,
+    follow_objects: bool,
+) -> (Outcome, Vec<CompletionRequest>) {
     let map = flat_a();
     let robot = SimRobot::new(map.clone());
     let b = Scripted::new(answers);
-    let out = plan_instruction(&b, &Prompts::builtin(), instruction, &v2(&map, &robot)).unwrap();
+    let mut ctx = v2(&map, &robot);
+    ctx.options.follow_objects = follow_objects;
+    let out = plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
     (out, b.requests())
 }
 
@@ -99,9 +112,10 @@ const BLACK_SOFA_RIGHT: &str =
 
 #[test]
 fn a_disagreement_gets_one_targeted_reask() {
-    let (out, reqs) = plan_scripted(
+    let (out, reqs) = plan_scripted_with(
         &[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT],
         "take me to the sofa, the black one",
+        false,
     );
     let p = out.plan().expect("a plan after the re-ask");
     assert_eq!(p.source, PlanSource::Llm { repairs: 1 });
@@ -128,9 +142,10 @@ fn a_disagreement_gets_one_targeted_reask() {
 fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
     let red_sofa =
         "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\n";
-    let (out, reqs) = plan_scripted(
+    let (out, reqs) = plan_scripted_with(
         &[red_sofa, BLACK_SOFA_RIGHT],
         "take me to the sofa, the black one",
+        false,
     );
     assert!(out.plan().is_some(), "{out:?}");
     assert_eq!(reqs.len(), 2);
@@ -139,9 +154,10 @@ fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
     assert_ne!(reqs[1].lark, reqs[0].lark);
     assert_ne!(reqs[1].grammar, reqs[0].grammar);
     // A finding that bars nothing (a said colour left out) keeps the first grammar.
-    let (_, reqs) = plan_scripted(
+    let (_, reqs) = plan_scripted_with(
         &[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT],
         "take me to the sofa, the black one",
+        false,
     );
     assert_eq!(reqs[1].lark, reqs[0].lark);
     assert_eq!(reqs[1].grammar, reqs[0].grammar);
@@ -346,6 +362,8 @@ fn no_rule_changes_a_typed_answer() {
 struct Spy<'a> {
     inner: &'a dyn LlmBackend,
     answers: Mutex<Vec<Completion>>,
+    /// Requests that continued an answer's text (its plan after its objects line).
+    continued: Mutex<usize>,
 }
 
 impl LlmBackend for Spy<'_> {
@@ -357,7 +375,20 @@ impl LlmBackend for Spy<'_> {
     }
     fn complete(&self, req: &CompletionRequest) -> Result<Completion, LlmError> {
         let c = self.inner.complete(req)?;
-        self.answers.lock().unwrap().push(c.clone());
+        // An answer comes in two requests (its objects line, then its plan continuing
+        // that text): the spy keeps each whole answer, as the layer reads it.
+        match req.messages.last() {
+            Some(m) if m.role == Role::Assistant => {
+                *self.continued.lock().unwrap() += 1;
+                let mut whole = c.clone();
+                whole.text = format!("{}{}", m.content, c.text);
+                self.answers.lock().unwrap().push(whole);
+            }
+            _ if c.text.contains("plan:") || c.finish_reason == FinishReason::Length => {
+                self.answers.lock().unwrap().push(c.clone());
+            }
+            _ => {}
+        }
         Ok(c)
     }
 }
@@ -376,6 +407,7 @@ fn smollm2_answers_follow_the_grammar_built_from_the_map() {
     let spy = Spy {
         inner: &backend,
         answers: Mutex::new(Vec::new()),
+        continued: Mutex::new(0),
     };
     let map = flat_a();
     let robot = SimRobot::new(map.clone());
@@ -384,10 +416,13 @@ fn smollm2_answers_follow_the_grammar_built_from_the_map() {
     ctx.options.plan_max_tokens = 160;
     // The three most similar worked examples only: a short prompt for the small model.
     ctx.options.examples = Some(3);
-    for instruction in [
-        "go to the second black chair and then face the tv",
-        "could you swing by the fridge and come back here",
+    // The first in two requests (its objects line, then the plan continuing it under the
+    // grammar that line narrows), the second in one.
+    for (instruction, follow_objects) in [
+        ("go to the second black chair and then face the tv", true),
+        ("could you swing by the fridge and come back here", false),
     ] {
+        ctx.options.follow_objects = follow_objects;
         let out = plan_instruction(&spy, &Prompts::builtin(), instruction, &ctx).unwrap();
         match &out {
             Outcome::Plan(p) => assert!(planner_dsl::Plan::compile(&p.script).is_ok()),
@@ -399,6 +434,10 @@ fn smollm2_answers_follow_the_grammar_built_from_the_map() {
     // (this model rambles) is checked up to its last complete line.
     let answers = spy.answers.lock().unwrap().clone();
     assert!(answers.len() >= 2);
+    assert!(
+        *spy.continued.lock().unwrap() >= 1,
+        "no plan continued its objects line"
+    );
     for c in &answers {
         let text = match c.finish_reason {
             FinishReason::Length => c.text.rsplit_once('\n').map_or("", |(a, _)| a),
@@ -467,8 +506,10 @@ fn a_prompt_set_that_quotes_the_words_gets_a_grammar_that_lets_the_model_quote_t
         (Prompts::builtin(), false),
     ] {
         let b = Scripted::new(&[answer]);
-        let out =
-            plan_instruction(&b, &prompts, "go to the black sofa", &v2(&map, &robot)).unwrap();
+        let mut ctx = v2(&map, &robot);
+        // One request, its grammar the whole answer's.
+        ctx.options.follow_objects = false;
+        let out = plan_instruction(&b, &prompts, "go to the black sofa", &ctx).unwrap();
         assert!(out.plan().is_some(), "{out:?}");
         let req = &b.requests()[0];
         let lark = req.lark.as_deref().unwrap();
@@ -481,4 +522,58 @@ fn a_prompt_set_that_quotes_the_words_gets_a_grammar_that_lets_the_model_quote_t
             "the first worked example's answer"
         );
     }
+}
+
+#[test]
+fn the_plan_is_written_after_the_objects_line_under_a_grammar_that_line_narrows() {
+    let (out, reqs) = plan_scripted_with(
+        &[
+            "objects: [(sofa, None, black)]\n",
+            "move_to_object(get_obj(\"sofa\", #{colour: \"black\"}));",
+        ],
+        "take me to the black sofa",
+        true,
+    );
+    let p = out.plan().expect("a plan");
+    assert_eq!(p.source, PlanSource::Llm { repairs: 0 });
+    assert_eq!(
+        p.script,
+        "agent.move_to_object(agent.get_obj(\"sofa\", #{colour: \"black\"}));\n"
+    );
+    // Two requests, one answer: the second continues the first's text after `plan:`.
+    assert_eq!((reqs.len(), p.timing.llm_calls), (2, 2));
+    assert_eq!(p.attempts.len(), 1);
+    assert!(p.attempts[0].starts_with("objects: [(sofa, None, black)]\nplan:\nmove_to_object("));
+    let prefill = reqs[1].messages.last().unwrap();
+    assert_eq!(prefill.role, Role::Assistant);
+    assert_eq!(prefill.content, "objects: [(sofa, None, black)]\nplan:\n");
+    assert_eq!(
+        reqs[1].messages[..reqs[1].messages.len() - 1],
+        reqs[0].messages[..]
+    );
+    // The first grammar is the objects line's, the second the plan's, where a sofa is
+    // picked by black, kept or excluded (red, the map's other sofa colour, is gone).
+    let (first, second) = (
+        reqs[0].lark.as_deref().unwrap(),
+        reqs[1].lark.as_deref().unwrap(),
+    );
+    assert!(first.contains("objects: [") && !first.contains("move_to_object("));
+    assert!(second.contains("move_to_object(") && !second.contains("objects: ["));
+    let sofa_colours = second
+        .lines()
+        .find(|l| l.starts_with("qcolour") && l.contains("black") && !l.contains("red"));
+    assert!(sofa_colours.is_some(), "{second}");
+}
+
+#[test]
+fn an_answer_written_whole_in_the_first_request_is_taken_as_it_is() {
+    // A backend that ignores the objects line's grammar (a server without grammars)
+    // answers in full at once: no second request.
+    let (out, reqs) = plan_scripted_with(
+        &[BLACK_SOFA_RIGHT],
+        "take me to the sofa, the black one",
+        true,
+    );
+    assert!(out.plan().is_some());
+    assert_eq!(reqs.len(), 1);
 }

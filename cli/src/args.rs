@@ -286,6 +286,12 @@ pub(crate) struct ModelArgs {
     /// (for comparison).
     #[arg(long)]
     pub(crate) no_reversed_draw: bool,
+    /// Write each answer in two requests, the objects line, then the plan under a grammar
+    /// that line narrows where the person's words agree with it (a pick of a name whose
+    /// every tuple gives a colour said before that name selects on one of them, kept or
+    /// excluded). Off by default until judged on the untuned sets.
+    #[arg(long)]
+    pub(crate) follow_objects: bool,
 }
 
 impl ModelArgs {
@@ -323,6 +329,7 @@ impl ModelArgs {
             redraws: self.redraws,
             redraw_temperature: self.redraw_temperature,
             reversed_draw: !self.no_reversed_draw,
+            follow_objects: self.follow_objects,
             ..PlanOptions::default()
         }
     }

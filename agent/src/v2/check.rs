@@ -385,7 +385,7 @@ fn is_region(map: &IvlMap, name: &str) -> bool {
 }
 
 /// The label of the map object `n` names, unless it names a region.
-fn object_label(map: &IvlMap, n: &str, pose: Pose) -> Option<String> {
+pub(crate) fn object_label(map: &IvlMap, n: &str, pose: Pose) -> Option<String> {
     let l = label_of(map, n, pose)?;
     (!is_region(map, &l)).then_some(l)
 }

@@ -38,6 +38,11 @@ pub struct Vocabulary {
     /// in [`Vocabulary::colours_of`]): a re-ask after a said colour the plan dropped
     /// ([`check::Bar::ColourDropped`](super::check::Bar::ColourDropped)).
     pub colour_required: Vec<String>,
+    /// Names whose picks must select on a colour, kept or excluded (`colour:` or
+    /// `not_colour:`, one of the name's colours in [`Vocabulary::colours_of`]): the plan
+    /// of an answer whose objects line gave every tuple of that name a colour
+    /// (`super::follow_objects`).
+    pub colour_key_required: Vec<String>,
     /// The colours a pick of each name may select on (`colour` and `not_colour`), as
     /// groups of names sharing one colour list (`None`: every name any of `colours`).
     /// A group with no colours picks that name without a colour key.
@@ -129,6 +134,7 @@ impl Vocabulary {
             no_sizes: false,
             no_far_end: false,
             colour_required: Vec::new(),
+            colour_key_required: Vec::new(),
             colours_of: None,
             region_keys: None,
             regions_of: (!map.regions.is_empty()).then_some(regions_of),
@@ -312,13 +318,13 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
     w.rule("tcolour", &format!("\"None\" | {}", alt(&colours, false)));
 }
 
-fn objects_only(d: Dialect, vocab: &Vocabulary) -> String {
+fn objects_only(d: Dialect, vocab: &Vocabulary, map_names: &[String]) -> String {
     let mut w = Writer::new(d);
     // The line ends as in the whole answer, with a newline (the request's stop string):
     // measured, without it Qwen 1.5B did not end the line (its "]\n" token is masked)
     // and listed made-up tuples to the token limit (held-out extraction: 2/48 exact).
     w.rule("root", "objects \"\\n\"");
-    objects_rules(&mut w, vocab, &[]);
+    objects_rules(&mut w, vocab, map_names);
     w.out
 }
 
@@ -326,13 +332,13 @@ fn objects_only(d: Dialect, vocab: &Vocabulary) -> String {
 /// order flags count, its names do not); rule `root`.
 #[must_use]
 pub fn objects_grammar(vocab: &Vocabulary) -> String {
-    objects_only(Dialect::Gbnf, vocab)
+    objects_only(Dialect::Gbnf, vocab, &[])
 }
 
 /// [`objects_grammar`] in Lark (llguidance); rule `start`.
 #[must_use]
 pub fn objects_lark(vocab: &Vocabulary) -> String {
-    objects_only(Dialect::Lark, vocab)
+    objects_only(Dialect::Lark, vocab, &[])
 }
 
 /// The rule that writes an argument of type `ty`.
@@ -422,12 +428,15 @@ struct SelKeys<'a> {
     not_from_end: bool,
     /// The map ends only after a `colour:` key (only with `colour`).
     colour_required: bool,
+    /// The map ends only after a `colour:` or `not_colour:` key (only with `colour`).
+    colour_key_required: bool,
 }
 
 impl SelKeys<'_> {
     /// Whether the map may end in `s`.
     fn may_end(&self, s: SelState) -> bool {
-        !self.colour_required || s.written & KEY_COLOUR != 0
+        (!self.colour_required || s.written & KEY_COLOUR != 0)
+            && (!self.colour_key_required || s.written & (KEY_COLOUR | KEY_NOT_COLOUR) != 0)
     }
 
     /// The keys that may come next in `s`, each as its text and the state after it.
@@ -487,6 +496,18 @@ impl SelKeys<'_> {
         if open(KEY_NEAR) {
             out.push(("\"near: \" obj".into(), after(KEY_NEAR, s.pending)));
         }
+        // A required colour key comes first, or right after the ordinal (the worked
+        // examples' order). Measured on held-out v2 (dev): required anywhere, the default
+        // model wrote the keys it meant (`ordinal: 2, order: "east_to_west"`), was
+        // refused the map's end, and went on to a region, an anchor and `not_colour:
+        // "black"` for "the second black stool from the east"; required first, it wrote
+        // the colour and then dropped the ordinal ("the second red chair from the east").
+        if self.colour_key_required && s.written & (KEY_COLOUR | KEY_NOT_COLOUR) == 0 {
+            out.retain(|(_, a)| {
+                a.written & (KEY_COLOUR | KEY_NOT_COLOUR) != 0
+                    || (s.written == 0 && a.written == KEY_ORDINAL)
+            });
+        }
         out
     }
 }
@@ -517,7 +538,7 @@ fn selection_rules(
     region: Option<&str>,
     vocab: &Vocabulary,
     not_from_end: bool,
-    colour_required: bool,
+    (colour_required, colour_key_required): (bool, bool),
 ) {
     let (positive, negative) = ordinal_signs(vocab);
     let keys = SelKeys {
@@ -526,7 +547,8 @@ fn selection_rules(
         positive,
         negative,
         not_from_end,
-        colour_required,
+        colour_required: colour_required && colour.is_some(),
+        colour_key_required: colour_key_required && colour.is_some(),
     };
     let name = |s: SelState| {
         let pending = match s.pending {
@@ -587,6 +609,9 @@ struct PickGroup {
     /// Its picks must select on a colour ([`Vocabulary::colour_required`]); only where
     /// it has a colour to offer.
     colour_required: bool,
+    /// Its picks must select on a colour or exclude one
+    /// ([`Vocabulary::colour_key_required`]); only where it has a colour to offer.
+    colour_key_required: bool,
 }
 
 /// The list of the group holding `name` in `groups` ([`Vocabulary::colours_of`],
@@ -604,7 +629,10 @@ pub(crate) fn group_list(
 /// The pick groups of `vocab` ([`Vocabulary::colours_of`] and [`Vocabulary::regions_of`]
 /// joined, the region lists cut to the region keys): `None` when neither narrows a name.
 fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
-    if vocab.colours_of.is_none() && vocab.regions_of.is_none() && vocab.colour_required.is_empty()
+    if vocab.colours_of.is_none()
+        && vocab.regions_of.is_none()
+        && vocab.colour_required.is_empty()
+        && vocab.colour_key_required.is_empty()
     {
         return None;
     }
@@ -617,12 +645,16 @@ fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
             r
         });
         // Required only where the pick has a colour key to write.
-        let colour_required = vocab.colour_required.contains(name)
-            && colours
-                .as_ref()
-                .map_or(!vocab.colours.is_empty(), |c| !c.is_empty());
+        let has_colours = colours
+            .as_ref()
+            .map_or(!vocab.colours.is_empty(), |c| !c.is_empty());
+        let colour_required = vocab.colour_required.contains(name) && has_colours;
+        let colour_key_required = vocab.colour_key_required.contains(name) && has_colours;
         match groups.iter_mut().find(|g| {
-            g.colours == colours && g.regions == regions && g.colour_required == colour_required
+            g.colours == colours
+                && g.regions == regions
+                && g.colour_required == colour_required
+                && g.colour_key_required == colour_key_required
         }) {
             Some(g) => g.names.push(name.clone()),
             None => groups.push(PickGroup {
@@ -630,6 +662,7 @@ fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
                 colours,
                 regions,
                 colour_required,
+                colour_key_required,
             }),
         }
     }
@@ -658,23 +691,66 @@ fn ordinal_signs(vocab: &Vocabulary) -> (bool, bool) {
 /// ```
 #[must_use]
 pub fn answer_grammar(vocab: &Vocabulary) -> String {
-    answer(vocab, Dialect::Gbnf)
+    answer(vocab, Dialect::Gbnf, Part::Whole)
 }
 
 /// [`answer_grammar`] in Lark, for llguidance (the same language); rule `start`.
 #[must_use]
 pub fn answer_lark(vocab: &Vocabulary) -> String {
-    answer(vocab, Dialect::Lark)
+    answer(vocab, Dialect::Lark, Part::Whole)
 }
 
-fn answer(vocab: &Vocabulary, d: Dialect) -> String {
+/// The answer's first part alone, in GBNF: its objects line (as [`answer_grammar`]'s,
+/// the map's names in `vocab`) and the newline after it. Rule `root`.
+#[must_use]
+pub fn answer_objects_grammar(vocab: &Vocabulary) -> String {
+    let names: Vec<String> = vocab.names.iter().chain(&vocab.regions).cloned().collect();
+    objects_only(Dialect::Gbnf, vocab, &names)
+}
+
+/// [`answer_objects_grammar`] in Lark; rule `start`.
+#[must_use]
+pub fn answer_objects_lark(vocab: &Vocabulary) -> String {
+    let names: Vec<String> = vocab.names.iter().chain(&vocab.regions).cloned().collect();
+    objects_only(Dialect::Lark, vocab, &names)
+}
+
+/// The answer's plan alone (what follows `plan:` and its newline), in GBNF: the
+/// statements of [`answer_grammar`]. Rule `root`.
+#[must_use]
+pub fn plan_grammar(vocab: &Vocabulary) -> String {
+    answer(vocab, Dialect::Gbnf, Part::Plan)
+}
+
+/// [`plan_grammar`] in Lark; rule `start`.
+#[must_use]
+pub fn plan_lark(vocab: &Vocabulary) -> String {
+    answer(vocab, Dialect::Lark, Part::Plan)
+}
+
+/// Which part of the answer a grammar holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Part {
+    /// The objects line, `plan:`, the plan.
+    Whole,
+    /// The plan after `plan:` alone.
+    Plan,
+}
+
+fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     let mut w = Writer::new(d);
     // Statements are separated (not ended) by newlines, as in the worked examples, so
     // that after the last `;` the model can end its turn as it saw there; at most 16
     // statements, so that a weak model that repeats itself stops.
-    w.rule("root", "objects \"\\nplan:\\n\" stmt (\"\\n\" stmt){0,15}");
-    let names: Vec<String> = vocab.names.iter().chain(&vocab.regions).cloned().collect();
-    objects_rules(&mut w, vocab, &names);
+    let stmts = "stmt (\"\\n\" stmt){0,15}";
+    match part {
+        Part::Whole => {
+            w.rule("root", &format!("objects \"\\nplan:\\n\" {stmts}"));
+            let names: Vec<String> = vocab.names.iter().chain(&vocab.regions).cloned().collect();
+            objects_rules(&mut w, vocab, &names);
+        }
+        Part::Plan => w.rule("root", stmts),
+    }
     let steps: Vec<String> = STEP_FUNCTIONS.iter().filter_map(|n| call_rule(n)).collect();
     if vocab.comments {
         // Each statement may follow a comment line quoting the person's words it carries
@@ -704,7 +780,7 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
         Some(groups) if !groups.is_empty() => {
             let mut picks = Vec::new();
             for (g, group) in groups.iter().enumerate() {
-                let sel = if group.colour_required {
+                let sel = if group.colour_required || group.colour_key_required {
                     format!("\", \" selmap{g}")
                 } else {
                     format!("(\", \" selmap{g})?")
@@ -778,7 +854,7 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
         all_regions,
         vocab,
         !not_from_end.is_empty(),
-        false,
+        (false, false),
     );
     for (g, group) in groups.iter().flatten().enumerate() {
         let colours = match &group.colours {
@@ -804,7 +880,7 @@ fn answer(vocab: &Vocabulary, d: Dialect) -> String {
             regions.as_deref(),
             vocab,
             !not_from_end.is_empty(),
-            group.colour_required,
+            (group.colour_required, group.colour_key_required),
         );
     }
     let (positive, negative) = ordinal_signs(vocab);
@@ -931,6 +1007,8 @@ pub(crate) mod tests {
             ("conversation", answer_grammar(&conversation)),
             ("no map", answer_grammar(&Vocabulary::default())),
             ("objects line", objects_grammar(&Vocabulary::default())),
+            ("answer's objects line", answer_objects_grammar(&vocab())),
+            ("plan alone", plan_grammar(&said)),
         ] {
             assert_eq!(undefined_rules(&g), Vec::<String>::new(), "{what}:\n{g}");
         }
@@ -1040,6 +1118,60 @@ pub(crate) mod tests {
             &["colour: \"red\", other_than: get_instance(9)"],
             &["other_than: get_instance(9)"],
         );
+    }
+
+    #[test]
+    fn the_answer_in_two_parts_is_the_whole_answer_cut_after_plan() {
+        let v = vocab();
+        let objects = "objects: [(couch, None, red), (chair, 2, None)]";
+        let plan = "move_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to_object(get_obj(\"chair\", #{ordinal: 2}));";
+        lark_accepts(&answer_lark(&v), &format!("{objects}\nplan:\n{plan}")).unwrap();
+        lark_accepts(&answer_objects_lark(&v), &format!("{objects}\n")).unwrap();
+        assert!(lark_accepts(&answer_objects_lark(&v), &format!("{objects}\nplan:\n")).is_err());
+        lark_accepts(&plan_lark(&v), plan).unwrap();
+        assert!(lark_accepts(&plan_lark(&v), &format!("{objects}\nplan:\n{plan}")).is_err());
+        // The answer's objects line bars a colour as an object word, as the whole
+        // answer's does (the extraction line too).
+        assert!(lark_accepts(&answer_objects_lark(&v), "objects: [(red, None, None)]\n").is_err());
+    }
+
+    #[test]
+    fn a_pick_whose_colour_key_is_required_selects_on_a_colour_kept_or_excluded() {
+        let mut v = vocab();
+        v.colour_key_required = vec!["sofa".into(), "couch".into()];
+        v.colours_of = Some(vec![(
+            vec!["sofa".into(), "couch".into()],
+            vec!["red".into()],
+        )]);
+        let lark = plan_lark(&v);
+        let sofa = |sel: &str| format!("move_to_object(get_obj(\"sofa\"{sel}));");
+        assert_offers(
+            &lark,
+            sofa,
+            &[
+                ", #{colour: \"red\"}",
+                ", #{not_colour: \"red\"}",
+                ", #{colour: \"red\", ordinal: 2}",
+                ", #{ordinal: 2, colour: \"red\"}",
+                ", #{ordinal: -1, not_colour: \"red\", order: \"near_to_far\"}",
+                ", #{colour: \"red\", near: get_obj(\"chair\")}",
+            ],
+            &[
+                "",
+                ", #{ordinal: 2}",
+                ", #{colour: \"black\"}",
+                ", #{region: \"kitchen\"}",
+                // it comes first, or right after the ordinal
+                ", #{order: \"near_to_far\", colour: \"red\"}",
+                ", #{ordinal: 2, near: get_obj(\"chair\"), colour: \"red\"}",
+            ],
+        );
+        // Other names keep every choice.
+        let chair = |sel: &str| format!("move_to_object(get_obj(\"chair\"{sel}));");
+        assert_offers(&lark, chair, &["", ", #{colour: \"black\"}"], &[]);
+        // A name with no colour to offer is not held to one.
+        v.colours_of = Some(vec![(vec!["sofa".into(), "couch".into()], vec![])]);
+        assert_offers(&plan_lark(&v), sofa, &[""], &[", #{colour: \"red\"}"]);
     }
 
     #[test]
