@@ -704,15 +704,18 @@ pub fn answer_lark(vocab: &Vocabulary) -> String {
 /// the map's names in `vocab`) and the newline after it. Rule `root`.
 #[must_use]
 pub fn answer_objects_grammar(vocab: &Vocabulary) -> String {
-    let names: Vec<String> = vocab.names.iter().chain(&vocab.regions).cloned().collect();
-    objects_only(Dialect::Gbnf, vocab, &names)
+    objects_only(Dialect::Gbnf, vocab, &map_names(vocab))
 }
 
 /// [`answer_objects_grammar`] in Lark; rule `start`.
 #[must_use]
 pub fn answer_objects_lark(vocab: &Vocabulary) -> String {
-    let names: Vec<String> = vocab.names.iter().chain(&vocab.regions).cloned().collect();
-    objects_only(Dialect::Lark, vocab, &names)
+    objects_only(Dialect::Lark, vocab, &map_names(vocab))
+}
+
+/// The names a map gives the objects line's words: its object names, then its regions.
+fn map_names(vocab: &Vocabulary) -> Vec<String> {
+    vocab.names.iter().chain(&vocab.regions).cloned().collect()
 }
 
 /// The answer's plan alone (what follows `plan:` and its newline), in GBNF: the
@@ -746,8 +749,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     match part {
         Part::Whole => {
             w.rule("root", &format!("objects \"\\nplan:\\n\" {stmts}"));
-            let names: Vec<String> = vocab.names.iter().chain(&vocab.regions).cloned().collect();
-            objects_rules(&mut w, vocab, &names);
+            objects_rules(&mut w, vocab, &map_names(vocab));
         }
         Part::Plan => w.rule("root", stmts),
     }

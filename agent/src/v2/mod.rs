@@ -514,8 +514,9 @@ fn answer_following_objects(
     ) else {
         return Ok(c1);
     };
-    let said = check::colour_nouns(ctx.map, instruction, ctx.pose());
-    let narrowed = follow_objects(vocab, ctx.map, &tuples, &said, ctx.pose());
+    let pose = ctx.pose();
+    let said = check::colour_nouns(ctx.map, instruction, pose);
+    let narrowed = follow_objects(vocab, ctx.map, &tuples, &said, pose);
     let prefix = format!("{}\nplan:\n", c1.text.trim_end());
     let mut second = req.clone();
     second.max_tokens = room;
