@@ -887,6 +887,88 @@ pub(crate) fn unsaid_regions<'a>(
         .collect()
 }
 
+/// Whether `instruction` asks the robot to come back to where it began (design.md:
+/// "come back here", "back to where you started", and in a conversation "where we
+/// started"): "back here", "come back" (or "go back", "head back", "get back") that
+/// ends its clause, "where you / we started" (began), "to the start" (starting point,
+/// beginning), "return" that ends its clause or goes "here". "Go back to the table"
+/// is not one: it names where to go.
+pub(crate) fn return_said(instruction: &str) -> bool {
+    // Clauses end at punctuation and at the words that join two requests.
+    let lower = instruction.to_lowercase();
+    let mut toks: Vec<&str> = Vec::new();
+    for piece in lower.split_inclusive(|c: char| matches!(c, ',' | '.' | ';' | '!' | '?')) {
+        toks.extend(
+            piece
+                .split(|c: char| !(c.is_alphanumeric() || c == '\''))
+                .filter(|w| !w.is_empty()),
+        );
+        if piece.ends_with([',', '.', ';', '!', '?']) {
+            toks.push(",");
+        }
+    }
+    let ends_clause = |i: usize| {
+        toks.get(i).is_none_or(|w| {
+            matches!(
+                *w,
+                "," | "and"
+                    | "then"
+                    | "please"
+                    | "pls"
+                    | "plz"
+                    | "again"
+                    | "now"
+                    | "after"
+                    | "afterwards"
+                    | "when"
+                    | "once"
+                    | "thanks"
+                    | "thx"
+                    | "here"
+                    | "home"
+            )
+        })
+    };
+    let moving = |i: usize| {
+        i.checked_sub(1).and_then(|j| toks.get(j)).is_some_and(|p| {
+            matches!(
+                *p,
+                "come" | "coming" | "go" | "going" | "head" | "get" | "drive" | "walk" | "move"
+            )
+        })
+    };
+    toks.iter().enumerate().any(|(i, w)| {
+        let next = toks.get(i + 1).copied();
+        match *w {
+            "back" => next == Some("here") || (moving(i) && ends_clause(i + 1)),
+            "return" | "returning" => ends_clause(i + 1),
+            "where" => {
+                matches!(next, Some("you" | "we" | "u" | "i" | "ya"))
+                    && toks.get(i + 2).is_some_and(|v| {
+                        matches!(*v, "started" | "start" | "began" | "begun" | "begin")
+                    })
+            }
+            "to" => {
+                let k = match next {
+                    Some("the" | "your" | "our" | "my" | "ur") => i + 2,
+                    _ => i + 1,
+                };
+                toks.get(k)
+                    .is_some_and(|v| matches!(*v, "start" | "starting" | "beginning"))
+            }
+            _ => false,
+        }
+    })
+}
+
+/// Whether `plan` moves back to where it began (`move_to_start()`) or to a position
+/// (`move_to([x, y])`, which a conversation's "where we started" is).
+pub(crate) fn plan_returns(plan: &TypedPlan) -> bool {
+    plan.steps
+        .iter()
+        .any(|s| matches!(s, Step::ToStart | Step::MoveTo(_)))
+}
+
 /// Whether a word of `instruction` starts with one of `stems`.
 fn starts_a_word(instruction: &str, stems: &[&str]) -> bool {
     words(instruction)
@@ -1152,6 +1234,19 @@ pub fn check_answer_after(
     let mut out = check_tuples(map, instruction, tuples, plan, pose, visited, refs);
     out.extend(check_names(map, instruction, plan, pose, visited, refs));
     out.extend(check_words(map, instruction, plan, pose, visited));
+    if return_said(instruction) && !plan_returns(plan) {
+        let to_model = if refs.is_empty() {
+            "the person asked to come back to where you began, but the plan never moves back: write move_to_start(); where their words say to come back"
+        } else {
+            "the person asked to come back, but the plan never moves back: write move_to_start(); for where this instruction began, or move_to([x, y]) with the position where we started, where their words say to come back"
+        };
+        out.push(Finding {
+            kind: FindingKind::Word,
+            to_model: to_model.into(),
+            to_user: "should I come back to where I started, and when?".into(),
+            bar: None,
+        });
+    }
     let known = known_colours(map, refs, earlier);
     let allowed = said_before(instruction, earlier);
     out.extend(check_unsaid_colours(map, &allowed, &known, plan, pose));
@@ -1982,6 +2077,68 @@ pub(crate) mod tests {
             "objects: [(sofa, None, purple)]\nplan:\nmove_to_object(get_obj(\"sofa\"));",
         );
         assert!(f.iter().any(|x| x.kind == FindingKind::NotOnMap), "{f:?}");
+    }
+
+    #[test]
+    fn coming_back_is_read_where_the_words_ask_for_it() {
+        for yes in [
+            "go to the sofa and come back here",
+            "go to the sofa, then come back",
+            "go to the sofa and then come back please",
+            "the sofa then get back here",
+            "go to the sofa and back to where you started",
+            "then back to where we started",
+            "go to the fridge, then return",
+            "go to the fridge and return to the start",
+            "head back to your starting point",
+            "go back to the start",
+            "go to the bed then go back, thanks",
+            "Go to the sofa. Come back!",
+        ] {
+            assert!(return_said(yes), "{yes}");
+        }
+        for no in [
+            "go to the sofa",
+            "go back to the table you just visited",
+            "come back to the kitchen",
+            "go to the sofa and come to the chair",
+            "return to the red sofa",
+            "the chair at the back of the room",
+            "go to the backpack",
+            "where is the sofa",
+            "go to the sofa where the chair is",
+        ] {
+            assert!(!return_said(no), "{no}");
+        }
+    }
+
+    #[test]
+    fn a_plan_that_never_comes_back_when_asked_to_is_found() {
+        let asked = "go to the red sofa and then come back here";
+        let come_back = |f: &[Finding]| f.iter().any(|x| x.to_model.contains("come back"));
+        let f = findings(
+            asked,
+            "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));",
+        );
+        assert!(come_back(&f), "{f:?}");
+        assert!(f.iter().all(|x| x.kind == FindingKind::Word), "{f:?}");
+        let f = findings(
+            asked,
+            "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to_start();",
+        );
+        assert!(!come_back(&f), "{f:?}");
+        // A position counts (a conversation's "where we started").
+        let f = findings(
+            asked,
+            "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to([1.0, 1.5]);",
+        );
+        assert!(!come_back(&f), "{f:?}");
+        // Not asked: not found.
+        let f = findings(
+            "go to the red sofa",
+            "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));",
+        );
+        assert!(!come_back(&f), "{f:?}");
     }
 
     #[test]

@@ -14,6 +14,10 @@ use map_core::{IvlMap, ObjectOrder};
 use planner_dsl::typed::{PICK_FUNCTION, STEP_FUNCTIONS};
 use planner_dsl::ParamType;
 
+/// The steps that move the robot back where the person asks it to come back: to where
+/// the plan began, or to a position (a conversation's "where we started").
+const RETURN_FUNCTIONS: &[&str] = &["move_to_start", "move_to"];
+
 /// What a map lets a plan name.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Vocabulary {
@@ -61,6 +65,10 @@ pub struct Vocabulary {
     /// prompt set whose worked examples quote the person's words above each call
     /// (`prompts/variants/quoted`). Off: the plan is calls only.
     pub comments: bool,
+    /// The plan must move back at least once (`move_to_start()` or `move_to([x, y])`):
+    /// the person asked to come back ([`check::return_said`](super::check)). Only where
+    /// the model would end the plan without one does this change what it may write.
+    pub return_required: bool,
 }
 
 /// The map's object names (each label with its synonyms) in groups sharing one list,
@@ -139,6 +147,7 @@ impl Vocabulary {
             region_keys: None,
             regions_of: (!map.regions.is_empty()).then_some(regions_of),
             comments: false,
+            return_required: false,
         }
     }
 }
@@ -745,7 +754,16 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     // Statements are separated (not ended) by newlines, as in the worked examples, so
     // that after the last `;` the model can end its turn as it saw there; at most 16
     // statements, so that a weak model that repeats itself stops.
-    let stmts = "stmt (\"\\n\" stmt){0,15}";
+    //
+    // Where the person asked to come back, the first move back (`ret`) is required: the
+    // statements before it are others (`stmt_nr`), so the grammar stays unambiguous and
+    // offers the model the same tokens as without it, except the end of the plan before
+    // a move back.
+    let stmts = if vocab.return_required {
+        "(stmt_nr \"\\n\"){0,15} ret (\"\\n\" stmt){0,15}"
+    } else {
+        "stmt (\"\\n\" stmt){0,15}"
+    };
     match part {
         Part::Whole => {
             w.rule("root", &format!("objects \"\\nplan:\\n\" {stmts}"));
@@ -754,18 +772,33 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         Part::Plan => w.rule("root", stmts),
     }
     let steps: Vec<String> = STEP_FUNCTIONS.iter().filter_map(|n| call_rule(n)).collect();
-    if vocab.comments {
+    let comment = if vocab.comments {
         // Each statement may follow a comment line quoting the person's words it carries
         // out (as the worked examples of such a prompt set do). Comments do not reach the
         // plan: Rhai drops them, the typed plan has none.
-        w.rule("stmt", "(comment \"\\n\")? (letstmt | step)");
         let text = w.pattern("[^\\n]{1,120}", "[^\\n]{1,120}");
         w.rule("comment", &format!("\"// \" {text}"));
+        "(comment \"\\n\")? "
     } else {
-        w.rule("stmt", "letstmt | step");
-    }
+        ""
+    };
+    w.rule("stmt", &format!("{comment}(letstmt | step)"));
     w.rule("letstmt", "\"let \" var \" = \" pick \";\"");
     w.rule("step", &format!("({}) \";\"", steps.join(" | ")));
+    if vocab.return_required {
+        let (back, other): (Vec<&str>, Vec<&str>) = STEP_FUNCTIONS
+            .iter()
+            .copied()
+            .partition(|n| RETURN_FUNCTIONS.contains(n));
+        let rules =
+            |names: Vec<&str>| -> Vec<String> { names.into_iter().filter_map(call_rule).collect() };
+        w.rule("stmt_nr", &format!("{comment}(letstmt | step_nr)"));
+        w.rule("step_nr", &format!("({}) \";\"", rules(other).join(" | ")));
+        w.rule(
+            "ret",
+            &format!("{comment}({}) \";\"", rules(back).join(" | ")),
+        );
+    }
     // A variable is never named like a library call (`get_...`): measured on
     // people.nav (dev) ob4, with any identifier on offer the default model wrote
     // `get_instance_by_` where an object goes, an unbound variable. Without that
@@ -1135,6 +1168,46 @@ pub(crate) mod tests {
         // The answer's objects line bars a colour as an object word, as the whole
         // answer's does (the extraction line too).
         assert!(lark_accepts(&answer_objects_lark(&v), "objects: [(red, None, None)]\n").is_err());
+    }
+
+    #[test]
+    fn a_plan_asked_to_come_back_cannot_end_before_it_moves_back() {
+        let mut v = vocab();
+        v.return_required = true;
+        let sofa = "move_to_object(get_obj(\"sofa\"));";
+        let whole = answer_lark(&v);
+        let objects = "objects: [(sofa, None, None)]\nplan:\n";
+        for plan in [
+            format!("{sofa}\nmove_to_start();"),
+            format!("move_to_start();\n{sofa}"),
+            format!("{sofa}\nmove_to([1.5, 2.0]);\n{sofa}\nmove_to_start();"),
+            format!("let s = get_obj(\"sofa\");\nmove_to_object(s);\nmove_to_start();"),
+        ] {
+            lark_accepts(&whole, &format!("{objects}{plan}")).unwrap();
+            lark_accepts(&plan_lark(&v), &plan).unwrap();
+        }
+        for plan in [
+            sofa.to_string(),
+            format!("{sofa}\nface(get_obj(\"chair\"));"),
+        ] {
+            assert!(
+                lark_accepts(&whole, &format!("{objects}{plan}")).is_err(),
+                "{plan}"
+            );
+            assert!(lark_accepts(&plan_lark(&v), &plan).is_err(), "{plan}");
+        }
+        // Every rule it uses is defined, with comments too.
+        assert_eq!(undefined_rules(&answer_grammar(&v)), Vec::<String>::new());
+        v.comments = true;
+        assert_eq!(undefined_rules(&answer_grammar(&v)), Vec::<String>::new());
+        lark_accepts(
+            &answer_lark(&v),
+            &format!("{objects}// the sofa\n{sofa}\n// come back\nmove_to_start();"),
+        )
+        .unwrap();
+        // Not asked: a plan may end anywhere.
+        v.return_required = false;
+        lark_accepts(&answer_lark(&v), &format!("{objects}{sofa}")).unwrap();
     }
 
     #[test]

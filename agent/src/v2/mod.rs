@@ -398,6 +398,8 @@ pub fn plan_instruction(
                 &check::said_before(instruction, ctx.earlier.as_deref()),
                 ctx,
             );
+            // Asked for by this instruction's words alone, as the checks read them.
+            v.return_required = check::return_said(instruction);
         }
         v
     };
