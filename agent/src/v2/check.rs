@@ -13,7 +13,8 @@
 //! person.
 
 use map_core::matcher::{canonical, is_colour_word};
-use map_core::{IvlMap, ObjectOrder, Pose};
+use map_core::select::Selection;
+use map_core::{IvlMap, ObjectOrder, Pose, QueryError};
 use planner_dsl::typed::{Object, Step, Target, TypedPlan};
 
 use crate::pipeline::{colour_counts, colour_list, noun};
@@ -961,6 +962,81 @@ pub(crate) fn return_said(instruction: &str) -> bool {
     })
 }
 
+/// "Between the two yellow tables" written as `move_in_between` of two picks of that
+/// name told apart only by their counts, where the name and its filters match other than
+/// two: a guess at which two (design.md: a question that says how many match). Seen on
+/// the dev chat suite's dlg-ob2 with three yellow tables, as the first and the second.
+/// Where exactly two match, the two picks are those two and nothing is found.
+fn check_two_guessed(
+    map: &IvlMap,
+    instruction: &str,
+    plan: &TypedPlan,
+    pose: Pose,
+) -> Vec<Finding> {
+    let w = words(instruction);
+    let said_two: Vec<String> = w
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| matches!(x.as_str(), "two" | "both" | "2"))
+        .filter_map(|(i, _)| noun_after(map, &w, i, pose).map(|(_, l)| l))
+        .collect();
+    let mut out = Vec::new();
+    for s in &plan.steps {
+        let Step::Between(Object::Pick(a), Object::Pick(b)) = s else {
+            continue;
+        };
+        let Some(label) = label_of(map, &a.name, pose) else {
+            continue;
+        };
+        let told_apart = a.colour != b.colour
+            || a.not_colour != b.not_colour
+            || a.region != b.region
+            || a.near.is_some()
+            || b.near.is_some()
+            || a.other_than.is_some()
+            || b.other_than.is_some();
+        if told_apart
+            || label_of(map, &b.name, pose).as_deref() != Some(label.as_str())
+            || !said_two.contains(&label)
+        {
+            continue;
+        }
+        let sel = Selection::<u32> {
+            name: label.clone(),
+            colour: a.colour.clone(),
+            not_colour: a.not_colour.clone(),
+            region: a.region.clone(),
+            ..Selection::default()
+        };
+        if let Err(QueryError::NotExactlyTwo { what, count, .. }) = map.select_pair(&sel, pose) {
+            let keys = [
+                a.colour.as_ref().map(|c| format!("colour: \"{c}\"")),
+                a.not_colour
+                    .as_ref()
+                    .map(|c| format!("not_colour: \"{c}\"")),
+                a.region.as_ref().map(|r| format!("region: \"{r}\"")),
+            ]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>();
+            let sel = if keys.is_empty() {
+                String::new()
+            } else {
+                format!(", #{{{}}}", keys.join(", "))
+            };
+            let f = Finding::new(
+                FindingKind::Word,
+                format!("the person said \"the two {what}\", but {count} match here and the plan picks two of them by their counts: write move_between_the_two(\"{label}\"{sel}) with the filters their words give"),
+                format!("\"the two {what}\" names {count} here: which two do you mean?"),
+            );
+            if !out.contains(&f) {
+                out.push(f);
+            }
+        }
+    }
+    out
+}
+
 /// Whether `plan` moves back to where it began (`move_to_start()`) or to a position
 /// (`move_to([x, y])`, which a conversation's "where we started" is).
 pub(crate) fn plan_returns(plan: &TypedPlan) -> bool {
@@ -1234,6 +1310,7 @@ pub fn check_answer_after(
     let mut out = check_tuples(map, instruction, tuples, plan, pose, visited, refs);
     out.extend(check_names(map, instruction, plan, pose, visited, refs));
     out.extend(check_words(map, instruction, plan, pose, visited));
+    out.extend(check_two_guessed(map, instruction, plan, pose));
     if return_said(instruction) && !plan_returns(plan) {
         let to_model = if refs.is_empty() {
             "the person asked to come back to where you began, but the plan never moves back: write move_to_start(); where their words say to come back"
@@ -2077,6 +2154,52 @@ pub(crate) mod tests {
             "objects: [(sofa, None, purple)]\nplan:\nmove_to_object(get_obj(\"sofa\"));",
         );
         assert!(f.iter().any(|x| x.kind == FindingKind::NotOnMap), "{f:?}");
+    }
+
+    #[test]
+    fn two_of_more_than_two_picked_by_their_counts_are_a_guess() {
+        let two = |f: &[Finding]| {
+            f.iter()
+                .filter(|x| x.to_model.contains("move_between_the_two"))
+                .count()
+        };
+        // flat-a: 3 black chairs of 8, 2 yellow tables of 4.
+        let f = findings(
+            "go between the two black chairs",
+            "objects: [(chair, None, black)]\nplan:\nmove_in_between(get_obj(\"chair\", #{ordinal: 1, colour: \"black\"}), get_obj(\"chair\", #{ordinal: 2, colour: \"black\"}));",
+        );
+        assert_eq!(two(&f), 1, "{f:?}");
+        let q = f
+            .iter()
+            .find(|x| x.to_model.contains("move_between_the_two"))
+            .unwrap();
+        assert!(q.to_model.contains("3 match here"), "{q:?}");
+        assert!(
+            q.to_model
+                .contains("move_between_the_two(\"chair\", #{colour: \"black\"})"),
+            "{q:?}"
+        );
+        assert_eq!(
+            q.to_user,
+            "\"the two black chairs\" names 3 here: which two do you mean?"
+        );
+        // Exactly two match: those are the two.
+        let f = findings(
+            "go between the two yellow tables",
+            "objects: [(table, None, yellow)]\nplan:\nmove_in_between(get_obj(\"table\", #{ordinal: 1, colour: \"yellow\"}), get_obj(\"table\", #{ordinal: 2, colour: \"yellow\"}));",
+        );
+        assert_eq!(two(&f), 0, "{f:?}");
+        // Told apart by their colours, or not said to be two: not a guess at two.
+        let f = findings(
+            "go between the red chair and the black chair",
+            "objects: [(chair, None, red), (chair, None, black)]\nplan:\nmove_in_between(get_obj(\"chair\", #{colour: \"red\"}), get_obj(\"chair\", #{colour: \"black\"}));",
+        );
+        assert_eq!(two(&f), 0, "{f:?}");
+        let f = findings(
+            "go between the first and the second black chair",
+            "objects: [(chair, 1, black), (chair, 2, black)]\nplan:\nmove_in_between(get_obj(\"chair\", #{ordinal: 1, colour: \"black\"}), get_obj(\"chair\", #{ordinal: 2, colour: \"black\"}));",
+        );
+        assert_eq!(two(&f), 0, "{f:?}");
     }
 
     #[test]
