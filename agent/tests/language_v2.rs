@@ -139,6 +139,54 @@ fn a_disagreement_gets_one_targeted_reask() {
 }
 
 #[test]
+fn asked_to_come_back_the_grammar_requires_a_move_back_and_a_plan_without_one_is_reasked() {
+    let no_return = BLACK_SOFA_RIGHT;
+    let with_return = "objects: [(sofa, None, black)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_start();\n";
+    let (out, reqs) = plan_scripted(
+        &[no_return, with_return],
+        "go to the black sofa and then come back here",
+    );
+    let p = out.plan().expect("a plan after the re-ask");
+    assert_eq!(p.source, PlanSource::Llm { repairs: 1 });
+    assert!(
+        p.script.ends_with("agent.move_to_start();\n"),
+        "{}",
+        p.script
+    );
+    let reask = &reqs[1].messages.last().unwrap().content;
+    assert!(reask.contains("come back"), "{reask}");
+    // The grammar (a backend that keeps it could not have written the first answer):
+    // the first move back is its own rule.
+    for r in &reqs {
+        let g = r.grammar.as_deref().unwrap();
+        assert!(g.contains("ret ::="), "{g}");
+    }
+    // Not asked: no such rule.
+    let (_, reqs) = plan_scripted(&[BLACK_SOFA_RIGHT], "go to the black sofa");
+    assert!(!reqs[0].grammar.as_deref().unwrap().contains("ret ::="));
+}
+
+#[test]
+fn between_the_two_of_three_picked_by_their_counts_is_a_question_not_a_guess() {
+    // flat-a has three black chairs.
+    let guess = "objects: [(chair, None, black)]\nplan:\nmove_in_between(get_obj(\"chair\", #{ordinal: 1, colour: \"black\"}), get_obj(\"chair\", #{ordinal: 2, colour: \"black\"}));\n";
+    let (out, reqs) = plan_scripted(&[guess; 4], "go and stand between the two black chairs");
+    match out {
+        Outcome::Question(q) => assert!(q.contains("names 3 here"), "{q}"),
+        other => panic!("expected a question, got {other:?}"),
+    }
+    assert!(
+        reqs[1]
+            .messages
+            .last()
+            .unwrap()
+            .content
+            .contains("move_between_the_two(\"chair\", #{colour: \"black\"})"),
+        "the re-ask names the form"
+    );
+}
+
+#[test]
 fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
     let red_sofa =
         "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\n";

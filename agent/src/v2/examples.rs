@@ -287,6 +287,14 @@ mod tests {
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let from_end = super::super::check::counted_from_the_end(&a.plan);
             assert!(from_end.is_empty(), "line {}: {from_end:?}", e.line);
+            // An example asked to come back moves back (the grammar then requires it).
+            if super::super::check::return_said(&e.instruction) {
+                assert!(
+                    super::super::check::plan_returns(&a.plan),
+                    "line {}",
+                    e.line
+                );
+            }
             planner_dsl::Plan::compile(&a.plan.to_rhai())
                 .unwrap_or_else(|err| panic!("example at line {}: {err}", e.line));
         }

@@ -1479,12 +1479,21 @@ pub(crate) mod tests {
             let mut v = examples_vocabulary(&examples);
             v.comments = quoted;
             let lark = answer_lark(&v);
+            v.return_required = true;
+            let coming_back = answer_lark(&v);
+            v.return_required = false;
             let mut commented = 0;
             for e in &examples {
                 let answer = e.answer.trim_end();
                 commented += usize::from(answer.contains("\n// "));
                 if let Err(why) = lark_accepts(&lark, answer) {
                     panic!("{origin}, line {}: {why}\n{answer}", e.line);
+                }
+                // Asked to come back, under the grammar that then requires it.
+                if crate::v2::check::return_said(&e.instruction) {
+                    if let Err(why) = lark_accepts(&coming_back, answer) {
+                        panic!("{origin}, line {}: {why}\n{answer}", e.line);
+                    }
                 }
             }
             let plain = "objects: [(chair, 3, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 3}));";
