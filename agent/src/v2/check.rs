@@ -898,13 +898,14 @@ pub(crate) fn return_said(instruction: &str) -> bool {
     // Clauses end at punctuation and at the words that join two requests.
     let lower = instruction.to_lowercase();
     let mut toks: Vec<&str> = Vec::new();
-    for piece in lower.split_inclusive(|c: char| matches!(c, ',' | '.' | ';' | '!' | '?')) {
+    const ENDS: [char; 5] = [',', '.', ';', '!', '?'];
+    for piece in lower.split_inclusive(ENDS) {
         toks.extend(
             piece
                 .split(|c: char| !(c.is_alphanumeric() || c == '\''))
                 .filter(|w| !w.is_empty()),
         );
-        if piece.ends_with([',', '.', ';', '!', '?']) {
+        if piece.ends_with(ENDS) {
             toks.push(",");
         }
     }

@@ -1181,7 +1181,7 @@ pub(crate) mod tests {
             format!("{sofa}\nmove_to_start();"),
             format!("move_to_start();\n{sofa}"),
             format!("{sofa}\nmove_to([1.5, 2.0]);\n{sofa}\nmove_to_start();"),
-            format!("let s = get_obj(\"sofa\");\nmove_to_object(s);\nmove_to_start();"),
+            "let s = get_obj(\"sofa\");\nmove_to_object(s);\nmove_to_start();".to_string(),
         ] {
             lark_accepts(&whole, &format!("{objects}{plan}")).unwrap();
             lark_accepts(&plan_lark(&v), &plan).unwrap();
