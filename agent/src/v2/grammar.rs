@@ -772,17 +772,21 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         Part::Plan => w.rule("root", stmts),
     }
     let steps: Vec<String> = STEP_FUNCTIONS.iter().filter_map(|n| call_rule(n)).collect();
-    let comment = if vocab.comments {
+    if vocab.comments {
         // Each statement may follow a comment line quoting the person's words it carries
         // out (as the worked examples of such a prompt set do). Comments do not reach the
         // plan: Rhai drops them, the typed plan has none.
+        w.rule("stmt", "(comment \"\\n\")? (letstmt | step)");
         let text = w.pattern("[^\\n]{1,120}", "[^\\n]{1,120}");
         w.rule("comment", &format!("\"// \" {text}"));
+    } else {
+        w.rule("stmt", "letstmt | step");
+    }
+    let comment = if vocab.comments {
         "(comment \"\\n\")? "
     } else {
         ""
     };
-    w.rule("stmt", &format!("{comment}(letstmt | step)"));
     w.rule("letstmt", "\"let \" var \" = \" pick \";\"");
     w.rule("step", &format!("({}) \";\"", steps.join(" | ")));
     if vocab.return_required {
