@@ -1039,7 +1039,8 @@ fn check_two_guessed(
 }
 
 /// Whether `plan` moves back to where it began (`move_to_start()`) or to a position
-/// (`move_to([x, y])`, which a conversation's "where we started" is).
+/// (`move_to([x, y])`, which a conversation's "where we started" is): the steps of
+/// `grammar::RETURN_FUNCTIONS`, which the grammar requires.
 pub(crate) fn plan_returns(plan: &TypedPlan) -> bool {
     plan.steps
         .iter()
@@ -1318,12 +1319,11 @@ pub fn check_answer_after(
         } else {
             "the person asked to come back, but the plan never moves back: write move_to_start(); for where this instruction began, or move_to([x, y]) with the position where we started, where their words say to come back"
         };
-        out.push(Finding {
-            kind: FindingKind::Word,
-            to_model: to_model.into(),
-            to_user: "should I come back to where I started, and when?".into(),
-            bar: None,
-        });
+        out.push(Finding::new(
+            FindingKind::Word,
+            to_model,
+            "should I come back to where I started, and when?",
+        ));
     }
     let known = known_colours(map, refs, earlier);
     let allowed = said_before(instruction, earlier);

@@ -15,7 +15,8 @@ use planner_dsl::typed::{PICK_FUNCTION, STEP_FUNCTIONS};
 use planner_dsl::ParamType;
 
 /// The steps that move the robot back where the person asks it to come back: to where
-/// the plan began, or to a position (a conversation's "where we started").
+/// the plan began, or to a position (a conversation's "where we started"); the steps
+/// [`check::plan_returns`](super::check::plan_returns) counts.
 const RETURN_FUNCTIONS: &[&str] = &["move_to_start", "move_to"];
 
 /// What a map lets a plan name.
@@ -772,19 +773,17 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         Part::Plan => w.rule("root", stmts),
     }
     let steps: Vec<String> = STEP_FUNCTIONS.iter().filter_map(|n| call_rule(n)).collect();
-    if vocab.comments {
+    // What a statement may follow (`stmt`, and `stmt_nr` and `ret` below).
+    let comment = if vocab.comments {
         // Each statement may follow a comment line quoting the person's words it carries
         // out (as the worked examples of such a prompt set do). Comments do not reach the
         // plan: Rhai drops them, the typed plan has none.
         w.rule("stmt", "(comment \"\\n\")? (letstmt | step)");
         let text = w.pattern("[^\\n]{1,120}", "[^\\n]{1,120}");
         w.rule("comment", &format!("\"// \" {text}"));
-    } else {
-        w.rule("stmt", "letstmt | step");
-    }
-    let comment = if vocab.comments {
         "(comment \"\\n\")? "
     } else {
+        w.rule("stmt", "letstmt | step");
         ""
     };
     w.rule("letstmt", "\"let \" var \" = \" pick \";\"");
