@@ -80,6 +80,10 @@ impl ChatRobot {
             ChatRobot::Sim(s) => s.clone(),
             ChatRobot::Real { robot, sim } => {
                 sim.reset_to(robot.current_pose());
+                // the stops it made, for what "the chair you visited first" counts over
+                sim.trajectory_mut()
+                    .stops
+                    .clone_from(&robot.trajectory().stops);
                 sim.clone()
             }
         }

@@ -273,6 +273,27 @@ pub enum QueryError {
         /// The selection's matched label.
         name: String,
     },
+    /// `visited` ("the bench you visited first") where no instance that matches has
+    /// been visited.
+    #[error("no {what} has been visited yet")]
+    NoneVisited {
+        /// What was asked for ("red chair").
+        what: String,
+    },
+    /// `not_visited` ("the lamp you haven't been to yet") where every instance that
+    /// matches has been visited.
+    #[error("every {what} here has been visited already")]
+    AllVisited {
+        /// What was asked for ("red chair").
+        what: String,
+    },
+    /// `visited` with another count (`ordinal`, `not_visited`): one selection counts one
+    /// way.
+    #[error("`visited` counts in the order of visits and `{other}` another way: give one of them")]
+    TwoCounts {
+        /// The other key.
+        other: &'static str,
+    },
     /// "Between the two X" where not exactly two instances match.
     #[error("\"the two {what}\" names {count} here, not 2 (ids {})", .ids.iter().map(u32::to_string).collect::<Vec<_>>().join(", "))]
     NotExactlyTwo {

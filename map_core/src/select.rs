@@ -12,14 +12,22 @@
 //! | "the red sofa", "the sofa, the red one", "a red sofa" | `colour: "red"` |
 //! | "the table that isn't yellow" | `not_colour: "yellow"` |
 //! | "the other red chair" (after visiting red chair 9), "a different one" | `other_than: 9` |
+//! | "the bench you visited first", "the first bike you went to" | `visited: 1` (counted in the order of first visits) |
+//! | "that same chair again", "the chair you were just at" | `visited: -1` (the latest visited) |
+//! | "the lamp you haven't been to yet" | `not_visited: true` (then the nearest of the rest) |
 //! | "the plant in the lounge" | `region: "lounge"` |
 //! | "the biggest table", "the smallest plant" | `ordinal: 1`, `largest_to_smallest` / `smallest_to_largest` |
 //! | "the chair next to / nearest / by the table" | `near: <the table's id>` (distances from its footprint) |
 //! | "between the two yellow tables" | [`IvlMap::select_pair`]: exactly two must match |
 //!
 //! Filters apply first (name, region, colour, excluded colour, the anchor itself
-//! left out, the instance `other_than` names left out), then the order ranks what is
-//! left and the ordinal picks.
+//! left out, the instance `other_than` names left out, with `not_visited` every visited
+//! instance left out), then the order ranks what is left and the ordinal picks. With
+//! `visited: k` only the visited instances stay, ranked in the order they were visited
+//! (first visits for k >= 1, latest visits for k <= -1), and k picks; `visited` and
+//! `ordinal` together are an error, never one silently winning. The visits are the
+//! caller's (the conversation's visited instances, oldest first:
+//! [`IvlMap::select_visited`]); [`IvlMap::select`] has none.
 //!
 //! ```
 //! use map_core::select::Selection;
@@ -93,6 +101,19 @@ pub struct Selection<A = u32> {
     /// ([`QueryError::OtherThanElsewhere`]); the ordinal counts what is left.
     #[serde(default = "Option::default", skip_serializing_if = "Option::is_none")]
     pub other_than: Option<A>,
+    /// Counted among the instances visited so far, in the order visited: k >= 1 the
+    /// k-th visited ("the bench you visited first"), -1 the latest visited ("that same
+    /// chair again"), 0 not given.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub visited: i64,
+    /// Only instances not visited so far ("the lamp you haven't been to yet").
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub not_visited: bool,
+}
+
+#[allow(clippy::trivially_copy_pass_by_ref)] // serde's skip_serializing_if passes a reference
+fn is_zero(k: &i64) -> bool {
+    *k == 0
 }
 
 impl<A> Default for Selection<A> {
@@ -106,6 +127,8 @@ impl<A> Default for Selection<A> {
             region: None,
             near: None,
             other_than: None,
+            visited: 0,
+            not_visited: false,
         }
     }
 }
@@ -170,6 +193,21 @@ impl<A> Selection<A> {
         self.other_than = Some(instance);
         self
     }
+
+    /// The k-th visited (k >= 1, in the order of first visits) or the latest visited
+    /// (-1, in the order of latest visits), among the instances visited so far.
+    #[must_use]
+    pub fn visited(mut self, k: i64) -> Self {
+        self.visited = k;
+        self
+    }
+
+    /// Leaving out every instance visited so far.
+    #[must_use]
+    pub fn not_visited(mut self) -> Self {
+        self.not_visited = true;
+        self
+    }
 }
 
 /// The distance between two footprints (0 when they touch).
@@ -200,6 +238,21 @@ impl IvlMap {
         self.select_with(&LexicalMatcher, sel, robot)
     }
 
+    /// [`IvlMap::select`] after `visits`: the instances visited so far, oldest first (a
+    /// repeat visit listed again), which `visited` and `not_visited` count over.
+    ///
+    /// # Errors
+    /// As [`IvlMap::select`]; and [`QueryError::NoneVisited`],
+    /// [`QueryError::AllVisited`] or [`QueryError::TwoCounts`] for the visit keys.
+    pub fn select_visited(
+        &self,
+        sel: &Selection,
+        robot: Pose,
+        visits: &[u32],
+    ) -> Result<&Instance, QueryError> {
+        self.pick_after(&LexicalMatcher, sel, robot, visits)
+    }
+
     /// [`IvlMap::select`] with a chosen [`NameMatcher`].
     ///
     /// # Errors
@@ -210,8 +263,22 @@ impl IvlMap {
         sel: &Selection,
         robot: Pose,
     ) -> Result<&Instance, QueryError> {
-        let k = sel.ordinal;
-        let (label, cands) = self.candidates_with(matcher, sel, robot)?;
+        self.pick_after(matcher, sel, robot, &[])
+    }
+
+    fn pick_after(
+        &self,
+        matcher: &dyn NameMatcher,
+        sel: &Selection,
+        robot: Pose,
+        visits: &[u32],
+    ) -> Result<&Instance, QueryError> {
+        let k = if sel.visited == 0 {
+            sel.ordinal
+        } else {
+            sel.visited
+        };
+        let (label, cands) = self.candidates_visited(matcher, sel, robot, visits)?;
         // k >= 1 counts from the front, -n from the back (-1 the last, -2 the second to
         // last), 0 is the first (the nearest by default).
         let idx = match k {
@@ -243,7 +310,20 @@ impl IvlMap {
     /// [`QueryError::NotExactlyTwo`] with the count, or the errors of
     /// [`IvlMap::select`] when nothing matches at all.
     pub fn select_pair(&self, sel: &Selection, robot: Pose) -> Result<[&Instance; 2], QueryError> {
-        let (label, cands) = self.candidates_with(&LexicalMatcher, sel, robot)?;
+        self.select_pair_visited(sel, robot, &[])
+    }
+
+    /// [`IvlMap::select_pair`] after `visits` (as [`IvlMap::select_visited`]).
+    ///
+    /// # Errors
+    /// As [`IvlMap::select_pair`] and [`IvlMap::select_visited`].
+    pub fn select_pair_visited(
+        &self,
+        sel: &Selection,
+        robot: Pose,
+        visits: &[u32],
+    ) -> Result<[&Instance; 2], QueryError> {
+        let (label, cands) = self.candidates_visited(&LexicalMatcher, sel, robot, visits)?;
         match cands[..] {
             [a, b] => Ok([a, b]),
             _ => Err(QueryError::NotExactlyTwo {
@@ -265,6 +345,30 @@ impl IvlMap {
         sel: &Selection,
         robot: Pose,
     ) -> Result<(String, Vec<&Instance>), QueryError> {
+        self.candidates_visited(matcher, sel, robot, &[])
+    }
+
+    /// [`IvlMap::candidates_with`] after `visits` (as [`IvlMap::select_visited`]); with
+    /// `visited` given, the visited candidates in the order of their visits.
+    ///
+    /// # Errors
+    /// As [`IvlMap::select_visited`], but for the ordinal.
+    pub fn candidates_visited(
+        &self,
+        matcher: &dyn NameMatcher,
+        sel: &Selection,
+        robot: Pose,
+        visits: &[u32],
+    ) -> Result<(String, Vec<&Instance>), QueryError> {
+        if sel.visited != 0 && (sel.ordinal != 0 || sel.not_visited) {
+            return Err(QueryError::TwoCounts {
+                other: if sel.not_visited {
+                    "not_visited"
+                } else {
+                    "ordinal"
+                },
+            });
+        }
         let labels: Vec<&str> = {
             let mut v: Vec<&str> = self.instances.iter().map(|i| i.label.as_str()).collect();
             v.sort_unstable();
@@ -381,6 +485,33 @@ impl IvlMap {
                     k: sel.ordinal.max(1),
                 });
             }
+        }
+        if sel.not_visited {
+            cands.retain(|i| !visits.contains(&i.id));
+            if cands.is_empty() {
+                return Err(QueryError::AllVisited {
+                    what: coloured(label, sel),
+                });
+            }
+        }
+        if sel.visited != 0 {
+            cands.retain(|i| visits.contains(&i.id));
+            if cands.is_empty() {
+                return Err(QueryError::NoneVisited {
+                    what: coloured(label, sel),
+                });
+            }
+            // First visits count from the front, latest visits from the back: after
+            // chair 2, chair 5, chair 2 again, the first visited is 2 and so is the latest.
+            let at = |i: &Instance| {
+                if sel.visited > 0 {
+                    visits.iter().position(|v| *v == i.id)
+                } else {
+                    visits.iter().rposition(|v| *v == i.id)
+                }
+            };
+            cands.sort_by_key(|i| at(i));
+            return Ok((label, cands));
         }
         let key = |i: &Instance| match (anchor, sel.order) {
             (Some(a), ObjectOrder::NearToFar) => footprint_distance(a, i),
@@ -522,6 +653,87 @@ mod tests {
             .select(&Selection::new("table").near(1), ORIGIN)
             .unwrap_err();
         assert_eq!(e.to_string(), "there are 0 other tables; asked for the 1st");
+    }
+
+    #[test]
+    fn visited_counts_in_the_order_of_visits() {
+        let m = map();
+        // tables visited 3, then 1, then 3 again; chair 14 between
+        let visits = [3, 14, 1, 3];
+        let sel = |s: Selection| m.select_visited(&s, ORIGIN, &visits).map(|i| i.id);
+        // "the table you visited first": 3, although 1 is nearer
+        assert_eq!(sel(Selection::new("table").visited(1)), Ok(3));
+        assert_eq!(sel(Selection::new("table").visited(2)), Ok(1));
+        // "that same table again": the latest visit, 3 (visited after 1)
+        assert_eq!(sel(Selection::new("table").visited(-1)), Ok(3));
+        assert_eq!(sel(Selection::new("table").visited(-2)), Ok(1));
+        // filters first: "the yellow table you visited first" with a colour
+        assert_eq!(
+            sel(Selection::new("table").colour("yellow").visited(2)),
+            Ok(1)
+        );
+        assert_eq!(sel(Selection::new("chair").visited(-1)), Ok(14));
+        // past the count, and nothing visited of the kind: errors that say so
+        let e = m
+            .select_visited(&Selection::new("table").visited(3), ORIGIN, &visits)
+            .unwrap_err();
+        assert_eq!(e.to_string(), "there are 2 tables; asked for the 3rd");
+        let e = m
+            .select_visited(
+                &Selection::new("table").colour("black").visited(1),
+                ORIGIN,
+                &visits,
+            )
+            .unwrap_err();
+        assert_eq!(e.to_string(), "no black table has been visited yet");
+        // without visits (a plain select) nothing has been visited
+        let e = m
+            .select(&Selection::new("table").visited(1), ORIGIN)
+            .unwrap_err();
+        assert!(matches!(e, QueryError::NoneVisited { .. }), "{e}");
+    }
+
+    #[test]
+    fn not_visited_leaves_every_visited_one_out() {
+        let m = map();
+        let visits = [1, 11];
+        let sel = |s: Selection| m.select_visited(&s, ORIGIN, &visits).map(|i| i.id);
+        // "a table you haven't been to yet": the nearest of 2, 3, 4
+        assert_eq!(sel(Selection::new("table").not_visited()), Ok(2));
+        assert_eq!(sel(Selection::new("table").not_visited().nth(-1)), Ok(4));
+        // "the red chair you haven't been to": 14, the one red chair left
+        assert_eq!(
+            sel(Selection::new("chair").colour("red").not_visited()),
+            Ok(14)
+        );
+        let e = m
+            .select_visited(
+                &Selection::new("chair").colour("red").not_visited(),
+                ORIGIN,
+                &[11, 14],
+            )
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "every red chair here has been visited already"
+        );
+    }
+
+    #[test]
+    fn visited_with_another_count_is_an_error_not_a_choice() {
+        let m = map();
+        for s in [
+            Selection::new("table").visited(1).nth(2),
+            Selection::new("table").visited(-1).not_visited(),
+        ] {
+            let e = m.select_visited(&s, ORIGIN, &[1, 3]).unwrap_err();
+            assert!(matches!(e, QueryError::TwoCounts { .. }), "{e}");
+        }
+        // and a pair after visits leaves the visited out the same way
+        let pair = m
+            .select_pair_visited(&Selection::new("table").not_visited(), ORIGIN, &[1, 2])
+            .unwrap();
+        assert_eq!([pair[0].id, pair[1].id], [3, 4]);
     }
 
     #[test]

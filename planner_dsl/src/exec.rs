@@ -51,14 +51,21 @@ pub fn run(plan: &Plan, map: &IvlMap, robot: &mut dyn Robot, limits: &Limits) ->
     }
 }
 
-/// Runs `plan` on a fresh copy of `robot` (same pose, empty trajectory) and returns
-/// the preview trajectory; the real robot is not touched.
+/// Runs `plan` on a fresh copy of `robot` (same pose, a trajectory of its own) and
+/// returns the preview trajectory, which holds only this plan's path and stops; the
+/// real robot is not touched. The copy starts with the robot's earlier stops, so that
+/// the selection keys `visited` and `not_visited` count what it visited before.
 pub fn dry_run(plan: &Plan, map: &IvlMap, robot: &SimRobot, limits: &Limits) -> DryRun {
     let mut copy = robot.fresh();
+    let earlier = robot.trajectory().stops.clone();
+    let n = earlier.len();
+    copy.trajectory_mut().stops = earlier;
     let outcome = run(plan, map, &mut copy, limits);
+    let mut trajectory = copy.trajectory().clone();
+    trajectory.stops.drain(..n.min(trajectory.stops.len()));
     DryRun {
         outcome,
-        trajectory: copy.trajectory().clone(),
+        trajectory,
     }
 }
 

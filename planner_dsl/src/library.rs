@@ -141,6 +141,22 @@ impl<'a> Host<'a> {
         self.robot
     }
 
+    /// The objects visited so far, oldest first, a repeat visit listed again: the
+    /// robot's stops at objects in its trajectory (in a conversation, every turn's, as
+    /// the session runs each plan on the same robot), which the selection keys
+    /// `visited` and `not_visited` count over.
+    fn visits(&self) -> Vec<u32> {
+        self.robot
+            .trajectory()
+            .stops
+            .iter()
+            .filter_map(|s| match s.target {
+                StopTarget::Instance(id) => Some(id),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Handles one call; `Err(())` means the plan must stop (the error is in
     /// `self.failure`).
     pub(crate) fn handle(
@@ -266,7 +282,10 @@ impl<'a> Host<'a> {
             }
             "get_obj" => {
                 let sel = self.selection_args(spec, args)?;
-                let inst = self.map.select(&sel, pose).map_err(map_err)?;
+                let inst = self
+                    .map
+                    .select_visited(&sel, pose, &self.visits())
+                    .map_err(map_err)?;
                 value(Dynamic::from(record(inst)))
             }
             "move_to" => {
@@ -321,7 +340,10 @@ impl<'a> Host<'a> {
             }
             "move_between_the_two" => {
                 let sel = self.selection_args(spec, args)?;
-                let [a, b] = self.map.select_pair(&sel, pose).map_err(map_err)?;
+                let [a, b] = self
+                    .map
+                    .select_pair_visited(&sel, pose, &self.visits())
+                    .map_err(map_err)?;
                 self.go(between_point(a, b), name, StopTarget::Between([a.id, b.id]))
             }
             "move_to_start" => {
@@ -542,7 +564,8 @@ impl<'a> Host<'a> {
         }
     }
 
-    /// A selection map: `#{ordinal, colour, not_colour, order, region, near, other_than}`
+    /// A selection map: `#{ordinal, colour, not_colour, order, region, near, other_than,
+    /// visited, not_visited}`
     /// ([`crate::registry::SELECTION_KEYS`]).
     fn selection_arg(
         &self,
@@ -575,6 +598,19 @@ impl<'a> Host<'a> {
                 "near" => sel.near = Some(self.object_key(spec, idx, v, "near")?),
                 "other_than" => {
                     sel.other_than = Some(self.object_key(spec, idx, v, "other_than")?)
+                }
+                "visited" => sel.visited = self.ordinal_arg(spec, idx, v)?,
+                "not_visited" => {
+                    sel.not_visited = v.as_bool().map_err(|_| {
+                        arg_err(
+                            spec,
+                            idx,
+                            format!(
+                                "key `not_visited` must be true or false, got {}",
+                                type_word(v)
+                            ),
+                        )
+                    })?;
                 }
                 other => {
                     return Err(arg_err(

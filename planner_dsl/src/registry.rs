@@ -35,7 +35,8 @@ pub enum ParamType {
     Id,
     /// What else the person said about the object, as a map with any of the keys
     /// `ordinal`, `colour`, `not_colour`, `order`, `region`, `near` (another object) and
-    /// `other_than` (an object left out) ([`SELECTION_KEYS`]): `#{ordinal: 2, near: table}`.
+    /// `other_than` (an object left out), `visited` (the k-th visited so far) and
+    /// `not_visited` ([`SELECTION_KEYS`]): `#{ordinal: 2, near: table}`.
     Selection,
 }
 
@@ -54,7 +55,7 @@ impl ParamType {
             ParamType::Text => "string",
             ParamType::Id => "integer id of an object on the map",
             ParamType::Selection => {
-                "map #{ordinal, colour, not_colour, order, region, near, other_than}, every key optional"
+                "map #{ordinal, colour, not_colour, order, region, near, other_than, visited, not_visited}, every key optional"
             }
         }
     }
@@ -137,7 +138,7 @@ impl FunctionSpec {
 }
 
 /// The keys of a selection map ([`ParamType::Selection`]), as the runtime reads them.
-pub const SELECTION_KEYS: [&str; 7] = [
+pub const SELECTION_KEYS: [&str; 9] = [
     "ordinal",
     "colour",
     "not_colour",
@@ -145,6 +146,8 @@ pub const SELECTION_KEYS: [&str; 7] = [
     "region",
     "near",
     "other_than",
+    "visited",
+    "not_visited",
 ];
 
 const fn req(name: &'static str, ty: ParamType, doc: &'static str) -> ParamSpec {
@@ -256,7 +259,7 @@ const SELECT_PARAMS: &[ParamSpec] = &[
     opt(
         "select",
         ParamType::Selection,
-        "ordinal: k-th (1 = first, -1 = last, -2 = second to last); colour: a colour it has; not_colour: a colour it must not have; order: what the ordinal counts in (default near_to_far; largest_to_smallest for \"the biggest\"); region: a room it is in; near: an object it is next to (distances then count from that object); other_than: an object of the same kind it is not (\"the other red chair\": the one visited left out)",
+        "ordinal: k-th (1 = first, -1 = last, -2 = second to last); colour: a colour it has; not_colour: a colour it must not have; order: what the ordinal counts in (default near_to_far; largest_to_smallest for \"the biggest\"); region: a room it is in; near: an object it is next to (distances then count from that object); other_than: an object of the same kind it is not (\"the other red chair\": the one visited left out); visited: counted among the objects visited so far, in the order visited, instead of an ordinal (1 = \"the one you visited first\", -1 = the latest visited, \"that same one again\"); not_visited: true leaves out every object visited so far (\"the lamp you haven't been to yet\")",
     ),
 ];
 

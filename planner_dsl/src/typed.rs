@@ -301,6 +301,13 @@ impl Reader {
         }
     }
 
+    fn boolean(&self, e: &Expr, f: &str) -> Result<bool, TypedError> {
+        match e {
+            Expr::BoolConstant(b, _) => Ok(*b),
+            other => Err(self.arg_err(other.position(), f, "expected true or false")),
+        }
+    }
+
     fn object(&self, e: &Expr, f: &str) -> Result<Object, TypedError> {
         match e {
             Expr::StringConstant(s, _) => Ok(Object::Name(s.to_string())),
@@ -391,6 +398,8 @@ impl Reader {
                                 "other_than" => {
                                     t.other_than = Some(Box::new(self.object(v, f)?));
                                 }
+                                "visited" => t.visited = self.int(Some(v), f)?,
+                                "not_visited" => t.not_visited = self.boolean(v, f)?,
                                 other => {
                                     return Err(self.arg_err(
                                         key.pos,
@@ -530,6 +539,12 @@ fn target_call(t: &Target, function: &str) -> String {
     }
     if let Some(o) = &t.other_than {
         keys.push(format!("other_than: {}", o.to_rhai()));
+    }
+    if t.visited != 0 {
+        keys.push(format!("visited: {}", t.visited));
+    }
+    if t.not_visited {
+        keys.push("not_visited: true".to_string());
     }
     if keys.is_empty() {
         format!("agent.{function}({})", lit(&t.name))

@@ -346,3 +346,79 @@ fn between_the_two_and_back_to_the_start() {
         "{back:?} vs {start:?}"
     );
 }
+
+/// "The sofa you visited first", "that same sofa again", "a table you haven't been to":
+/// counted over the robot's stops at objects, across plans run on the same robot (a
+/// conversation's turns) and in a dry run.
+#[test]
+fn visited_counts_the_stops_of_earlier_plans_on_the_same_robot() {
+    let (map, _) = world("flat-a");
+    let mut robot = map_core::SimRobot::new(map.clone());
+    let go = |src: &str, robot: &mut map_core::SimRobot| {
+        let plan = Plan::compile(src).unwrap();
+        run(&plan, &map, robot, &Limits::default())
+    };
+    let last_stop =
+        |robot: &map_core::SimRobot| robot.trajectory().stops.last().unwrap().target.clone();
+    // before any visit there is nothing to count
+    let out = go(
+        "move_to_object(get_obj(\"sofa\", #{visited: 1}));",
+        &mut robot,
+    );
+    let e = out.error.unwrap();
+    assert_eq!(e.kind, RuntimeErrorKind::Map);
+    assert_eq!(e.message, "no sofa has been visited yet");
+    // turn 1: the black sofa (2), then the red one (1)
+    let out = go(
+        "move_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));",
+        &mut robot,
+    );
+    assert!(out.error.is_none(), "{:?}", out.error);
+    // turn 2: "the sofa you visited first" is the black one, though the red is nearer
+    let out = go(
+        "move_to_object(get_obj(\"sofa\", #{visited: 1}));",
+        &mut robot,
+    );
+    assert!(out.error.is_none(), "{:?}", out.error);
+    assert_eq!(last_stop(&robot), map_core::StopTarget::Instance(2));
+    // "that same sofa again": the latest visit, the black one again
+    let out = go(
+        "move_to_object(get_obj(\"sofa\", #{visited: -1}));",
+        &mut robot,
+    );
+    assert!(out.error.is_none(), "{:?}", out.error);
+    assert_eq!(last_stop(&robot), map_core::StopTarget::Instance(2));
+    let out = go(
+        "move_to_object(get_obj(\"sofa\", #{visited: -2}));",
+        &mut robot,
+    );
+    assert!(out.error.is_none(), "{:?}", out.error);
+    assert_eq!(last_stop(&robot), map_core::StopTarget::Instance(1));
+    // a dry run counts the same visits, and its preview holds only its own stops
+    let plan = Plan::compile("move_to_object(get_obj(\"sofa\", #{not_visited: true}));").unwrap();
+    let preview = dry_run(&plan, &map, &robot, &Limits::default());
+    let e = preview.outcome.error.unwrap();
+    assert_eq!(e.message, "every sofa here has been visited already");
+    let plan = Plan::compile("move_to_object(get_obj(\"sofa\", #{visited: 2}));").unwrap();
+    let preview = dry_run(&plan, &map, &robot, &Limits::default());
+    assert!(
+        preview.outcome.error.is_none(),
+        "{:?}",
+        preview.outcome.error
+    );
+    assert_eq!(preview.trajectory.stops.len(), 1);
+    assert_eq!(
+        preview.trajectory.stops[0].target,
+        map_core::StopTarget::Instance(1)
+    );
+    // one way of counting at a time, and the keys' types are checked
+    let out = go("get_obj(\"sofa\", #{visited: 1, ordinal: 2});", &mut robot);
+    assert!(out.error.unwrap().message.contains("give one of them"));
+    let out = go("get_obj(\"sofa\", #{not_visited: 1});", &mut robot);
+    let e = out.error.unwrap();
+    assert_eq!(e.kind, RuntimeErrorKind::Argument);
+    assert!(
+        e.message.contains("`not_visited` must be true or false"),
+        "{e}"
+    );
+}

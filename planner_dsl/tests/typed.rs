@@ -214,20 +214,25 @@ fn arb_target() -> impl Strategy<Value = Target> {
         proptest::option::of(s),
         0..ObjectOrder::ALL.len(),
         proptest::option::of(s),
+        (-3i64..4, proptest::bool::ANY),
     )
-        .prop_map(|(name, ordinal, colour, not_colour, order, region)| {
-            let nonempty = |o: Option<String>| o.filter(|x| !x.trim().is_empty());
-            Target {
-                name,
-                ordinal,
-                colour: nonempty(colour),
-                not_colour: nonempty(not_colour),
-                order: ObjectOrder::ALL[order].0,
-                region: nonempty(region),
-                near: None,
-                other_than: None,
-            }
-        })
+        .prop_map(
+            |(name, ordinal, colour, not_colour, order, region, (visited, not_visited))| {
+                let nonempty = |o: Option<String>| o.filter(|x| !x.trim().is_empty());
+                Target {
+                    name,
+                    ordinal,
+                    colour: nonempty(colour),
+                    not_colour: nonempty(not_colour),
+                    order: ObjectOrder::ALL[order].0,
+                    region: nonempty(region),
+                    near: None,
+                    other_than: None,
+                    visited,
+                    not_visited,
+                }
+            },
+        )
 }
 
 proptest! {

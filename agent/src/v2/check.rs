@@ -618,11 +618,14 @@ fn check_words(
                 }
                 // From the end ("last", "penultimate"): -k, or k counted from the other
                 // end of an order the person gave.
+                // "The second chair you visited" counts the visits (`visited: 2`).
                 let counts = |t: &Target| {
                     if k < 0 {
-                        t.ordinal == k || (t.ordinal == -k && t.order != ObjectOrder::NearToFar)
+                        t.ordinal == k
+                            || t.visited == k
+                            || (t.ordinal == -k && t.order != ObjectOrder::NearToFar)
                     } else {
-                        t.ordinal.abs() == k
+                        t.ordinal.abs() == k || t.visited == k
                     }
                 };
                 let wanted = if k < 0 {

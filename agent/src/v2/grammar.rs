@@ -526,7 +526,8 @@ impl SelKeys<'_> {
 /// least one (as a Rhai map literal takes them); colours from the rule `colour` (none:
 /// no colour keys), regions from the rule `region` (none: no region key). Its key rules
 /// are `sel{suffix}_{written}_{pending}`, one per state of [`SelState`] reached. In a
-/// conversation (`vocab.ids`), `other_than: get_instance(id)` may end the map.
+/// conversation (`vocab.ids`), `other_than: get_instance(id)`, `visited: k` (without an
+/// ordinal) or `not_visited: true` may end the map.
 ///
 /// Measured on held-out v2 (dev): with the keys in one fixed order (ordinal, colour,
 /// not_colour, order, region, near), the default model, whose own order was
@@ -604,6 +605,12 @@ fn selection_rules(
         // states (each key written doubles them).
         if !vocab.ids.is_empty() && keys.may_end(s) {
             alternatives.push("\"other_than: \" inst".into());
+            // "The bench you visited first", "the lamp you haven't been to yet": counted
+            // over the visits, never with an ordinal as well (the runtime refuses both).
+            if s.written & KEY_ORDINAL == 0 {
+                alternatives.push("\"visited: \" vint".into());
+            }
+            alternatives.push("\"not_visited: true\"".into());
         }
         w.rule(&name(s), &alternatives.join(" | "));
     }
@@ -842,6 +849,8 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             "inst",
             &format!("\"get_instance(\" ({}) \")\"", alt(&ids, false)),
         );
+        let vint = w.pattern("\"-\"? [1-9]", "-?[1-9]");
+        w.rule("vint", &vint);
     }
     // Objects are picked by their names; a bare name may also be a region (a room).
     if vocab.names.is_empty() {
@@ -1155,6 +1164,40 @@ pub(crate) mod tests {
             pick,
             &["colour: \"red\", other_than: get_instance(9)"],
             &["other_than: get_instance(9)"],
+        );
+    }
+
+    #[test]
+    fn visits_are_counted_only_in_a_conversation_and_never_with_an_ordinal() {
+        let mut conversation = vocab();
+        conversation.ids = vec![4, 9];
+        let pick = |sel: &str| {
+            format!("objects: [(chair, None, red)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));")
+        };
+        assert_offers(
+            &answer_lark(&conversation),
+            pick,
+            &[
+                "visited: 1",
+                "visited: -1",
+                "colour: \"red\", visited: 2",
+                "not_visited: true",
+                "colour: \"red\", not_visited: true",
+                "ordinal: 2, not_visited: true",
+            ],
+            &[
+                // with an ordinal, before another key, zero, false
+                "ordinal: 2, visited: 1",
+                "visited: 1, colour: \"red\"",
+                "visited: 0",
+                "not_visited: false",
+            ],
+        );
+        assert_offers(
+            &answer_lark(&vocab()),
+            pick,
+            &["colour: \"red\""],
+            &["visited: 1", "not_visited: true"],
         );
     }
 
