@@ -966,6 +966,170 @@ pub(crate) fn return_said(instruction: &str) -> bool {
     })
 }
 
+/// What a chat reference says of the object it means: visited earlier ("the bench you
+/// visited first", "that same chair", "the chair again") or not ("the other counter",
+/// "the lamp you haven't been to yet").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Visit {
+    Earlier,
+    NotYet,
+}
+
+/// The chat references in `instruction`: each with the words that make it, what it says
+/// of the visits and the map label it is said of (`None`: "one", "the other one").
+/// Only references whose object is named or is "one": "the other side", "the kitchen
+/// again" refer to no visited object.
+fn visit_references(
+    map: &IvlMap,
+    instruction: &str,
+    pose: Pose,
+) -> Vec<(String, Visit, Option<String>)> {
+    let w = words(instruction);
+    let at = |i: usize| w.get(i).map_or("", String::as_str);
+    let one_at = |i: usize| matches!(at(i), "one" | "ones");
+    let mut out = Vec::new();
+    let mut push = |said: String, v: Visit, label: Option<String>, one: bool| {
+        // once each: "the same chair again" is one reference
+        if (label.is_some() || one) && !out.iter().any(|(_, w, l)| *w == v && *l == label) {
+            out.push((said, v, label));
+        }
+    };
+    for (i, word) in w.iter().enumerate() {
+        let before = |n: usize| &w[i.saturating_sub(n)..i];
+        match word.as_str() {
+            "other" | "another" | "different" | "remaining" => {
+                let label = noun_after(map, &w, i, pose).map(|(_, l)| l);
+                let one = (i + 1..(i + 4).min(w.len())).any(one_at);
+                push(format!("{word} {}", at(i + 1)), Visit::NotYet, label, one);
+            }
+            "same" | "previous" => {
+                let label = noun_after(map, &w, i, pose).map(|(_, l)| l);
+                let one = (i + 1..(i + 4).min(w.len())).any(one_at);
+                push(format!("{word} {}", at(i + 1)), Visit::Earlier, label, one);
+            }
+            "again" => {
+                let label = noun_before(map, &w, i, pose);
+                push(
+                    format!("{} again", at(i.wrapping_sub(1))),
+                    Visit::Earlier,
+                    label,
+                    i > 0 && one_at(i - 1),
+                );
+            }
+            "visited" | "been" | "went" | "gone" | "were" | "skipped" | "tried" => {
+                // "you were at", "you went to": a place after the verb.
+                if matches!(word.as_str(), "were" | "went" | "gone" | "been")
+                    && !matches!(at(i + 1), "to" | "at" | "by" | "past")
+                {
+                    continue;
+                }
+                // The subject right before ("you", "u", "we", after a "havent"), and the
+                // object named before it: "the bench you visited first".
+                let Some(subject) = before(3)
+                    .iter()
+                    .rposition(|x| matches!(x.as_str(), "you" | "u" | "we" | "ya"))
+                    .map(|k| i.saturating_sub(3) + k)
+                else {
+                    continue;
+                };
+                let negated = word == "skipped"
+                    || w[subject..i].iter().any(|x| {
+                        matches!(
+                            x.as_str(),
+                            "haven't"
+                                | "havent"
+                                | "have"
+                                | "not"
+                                | "never"
+                                | "didn't"
+                                | "didnt"
+                                | "did"
+                                | "hadn't"
+                                | "hadnt"
+                        )
+                    });
+                let label = noun_before(map, &w, subject, pose);
+                let one = subject > 0 && one_at(subject - 1);
+                let v = if negated {
+                    Visit::NotYet
+                } else {
+                    Visit::Earlier
+                };
+                push(w[subject..=i].join(" "), v, label, one);
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// Chat references against the plan's stops (`stops`: the dry run's objects, in order)
+/// and the conversation's earlier visits (`refs`): "the X you visited" with no stop at a
+/// visited X, "the other X" with every stop at an X visited before. Measured on held-out
+/// v5 (read after its run, untuned no more): "back to the bench you visited first" as
+/// the nearest bench, "other counter now pls" as the counter just visited, "the table you
+/// havent visited yet" as a visited table; each a silent wrong plan.
+fn check_visits(
+    map: &IvlMap,
+    instruction: &str,
+    pose: Pose,
+    stops: &[u32],
+    refs: &[u32],
+) -> Vec<Finding> {
+    // Only with the dry run's stops: without them nothing says where the plan goes.
+    if refs.is_empty() || stops.is_empty() {
+        return Vec::new();
+    }
+    let label_of_id = |id: u32| map.instance_by_id(id).map(|i| i.label.clone());
+    let of = |id: &u32, label: &Option<String>| {
+        label.is_none() || label_of_id(*id).as_ref() == label.as_ref()
+    };
+    let visited_of = |label: &Option<String>| -> String {
+        let ids: Vec<String> = refs
+            .iter()
+            .filter(|id| of(id, label))
+            .filter_map(|id| {
+                map.instance_by_id(*id).map(|i| {
+                    format!(
+                        "{} {} ({})",
+                        i.label,
+                        i.id,
+                        i.colour.as_deref().unwrap_or("unknown colour")
+                    )
+                })
+            })
+            .collect();
+        if ids.is_empty() {
+            "none".to_string()
+        } else {
+            ids.join(", ")
+        }
+    };
+    let mut out = Vec::new();
+    for (said, v, label) in visit_references(map, instruction, pose) {
+        let what = label.clone().unwrap_or_else(|| "object".to_string());
+        let mine: Vec<&u32> = stops.iter().filter(|id| of(id, &label)).collect();
+        match v {
+            Visit::Earlier if !mine.iter().any(|id| refs.contains(id)) => {
+                out.push(Finding::new(
+                    FindingKind::Word,
+                    format!("the person said \"{said}\", a {what} visited earlier, but the plan goes to no {what} visited earlier (visited: {}): pick it with visited: 1 for the first visited, visited: -1 for the latest, or get_instance(id)", visited_of(&label)),
+                    format!("which {what} do you mean? I have been to: {}", visited_of(&label)),
+                ));
+            }
+            Visit::NotYet if !mine.is_empty() && mine.iter().all(|id| refs.contains(id)) => {
+                out.push(Finding::new(
+                    FindingKind::Word,
+                    format!("the person said \"{said}\", a {what} not visited yet, but the plan goes back to one visited earlier (visited: {}): leave the visited ones out with not_visited: true", visited_of(&label)),
+                    format!("which {what} do you mean? I have been to: {}", visited_of(&label)),
+                ));
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
 /// "Between the two yellow tables" written as `move_in_between` of two picks of that
 /// name told apart only by their counts, where the name and its filters match other than
 /// two: a guess at which two (design.md: a question that says how many match). Seen on
@@ -1316,6 +1480,7 @@ pub fn check_answer_after(
     out.extend(check_names(map, instruction, plan, pose, visited, refs));
     out.extend(check_words(map, instruction, plan, pose, visited));
     out.extend(check_two_guessed(map, instruction, plan, pose));
+    out.extend(check_visits(map, instruction, pose, visited, refs));
     if return_said(instruction) && !plan_returns(plan) {
         let to_model = if refs.is_empty() {
             "the person asked to come back to where you began, but the plan never moves back: write move_to_start(); where their words say to come back"
@@ -2462,6 +2627,61 @@ pub(crate) mod tests {
             "objects: [(chair, None, None), (table, 2, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{near: get_obj(\"table\", #{ordinal: 2})}));",
         );
         assert!(right.is_empty(), "{right:?}");
+    }
+
+    #[test]
+    fn chat_references_are_checked_against_the_visits() {
+        let m = map();
+        let refs = |instruction: &str, stops: &[u32], earlier: &[u32]| {
+            check_visits(&m, instruction, m.start_pose, stops, earlier)
+        };
+        // "the other sofa" after sofa 2: going to 2 again is found, 1 is right
+        let f = refs("now the other sofa", &[2], &[2]);
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert!(f[0].to_model.contains("not_visited: true"), "{f:?}");
+        assert!(f[0].to_user.contains("sofa 2 (black)"), "{f:?}");
+        assert!(refs("now the other sofa", &[1], &[2]).is_empty());
+        assert!(refs("ok now the other one", &[1], &[2]).is_empty());
+        assert_eq!(refs("ok now the other one", &[2], &[2]).len(), 1);
+        // "the table you havent visited yet" after tables 8 and 3
+        assert_eq!(
+            refs("now the table you havent visited yet", &[8], &[8, 3]).len(),
+            1
+        );
+        assert!(refs("now the table you havent visited yet", &[17], &[8, 3]).is_empty());
+        // "back to the table you visited first" must go to a visited table
+        let f = refs(
+            "go to the tv and then back to the table you visited first",
+            &[4, 17],
+            &[8, 3],
+        );
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert!(f[0].to_model.contains("visited: 1"), "{f:?}");
+        assert!(refs(
+            "go to the tv and then back to the table you visited first",
+            &[4, 8],
+            &[8, 3]
+        )
+        .is_empty());
+        // "the same chair again", "the red one again", "that desk you were at"
+        assert_eq!(refs("the same chair again", &[13], &[9]).len(), 1);
+        assert!(refs("the same chair again", &[9], &[9]).is_empty());
+        assert_eq!(refs("go back to the red one again", &[10], &[9]).len(), 1);
+        assert!(refs("back to the desk you were at", &[25], &[25, 4]).is_empty());
+        // mixed: the other fridge-like pick and the same table again, each on its own
+        assert!(refs(
+            "the other sofa, and after that the same table again",
+            &[1, 8],
+            &[2, 8]
+        )
+        .is_empty());
+        // not references to a visited object: a room again, the other side, "went" alone
+        assert!(refs("go to the kitchen again", &[24], &[22]).is_empty());
+        assert!(refs("go to the other side of the table", &[8], &[8]).is_empty());
+        assert!(refs("you went too far, go to the sofa", &[2], &[2]).is_empty());
+        // outside a conversation, or without the dry run's stops, nothing is judged
+        assert!(refs("the same chair again", &[13], &[]).is_empty());
+        assert!(refs("the same chair again", &[], &[9]).is_empty());
     }
 
     #[test]
