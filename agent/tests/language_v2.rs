@@ -625,3 +625,57 @@ fn an_answer_written_whole_in_the_first_request_is_taken_as_it_is() {
     assert!(out.plan().is_some());
     assert_eq!(reqs.len(), 1);
 }
+
+/// design.md's chat references through the visit keys: "the other sofa" answered with
+/// the sofa just visited is re-asked (the check that reads the references against the
+/// dry run's stops), and the re-ask's `not_visited` runs; "the sofa you visited first"
+/// is `visited: 1`, counted over every turn's stops on the session's robot.
+#[test]
+fn chat_references_count_the_visits_and_a_revisit_for_the_other_one_is_reasked() {
+    let map = flat_a();
+    let prompts = Prompts::builtin();
+    let mut session = Session::new(map.start_pose);
+    let mut robot = SimRobot::new(map.clone());
+    let mut turn = |say: &str, answers: &[&str], robot: &mut SimRobot| {
+        let b = Scripted::new(answers);
+        let planning = robot.clone();
+        let out = session
+            .plan(&b, &prompts, say, &v2(&map, &planning))
+            .unwrap();
+        let p = out
+            .plan()
+            .cloned()
+            .unwrap_or_else(|| panic!("{say}: {out:?}"));
+        let run = session.execute(&p, &map, robot, &Limits::default());
+        assert!(run.error.is_none(), "{say}: {:?}", run.error);
+        let stop = robot.trajectory().stops.last().unwrap().target.clone();
+        (p, b.requests(), stop)
+    };
+    use map_core::{Robot, StopTarget};
+    let (_, _, stop) = turn("go to the black sofa", &[BLACK_SOFA_RIGHT], &mut robot);
+    assert_eq!(stop, StopTarget::Instance(2));
+    let again = "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_instance(2));\n";
+    let other = "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{not_visited: true}));\n";
+    let (p, reqs, stop) = turn("thanks, now the other sofa", &[again, other], &mut robot);
+    assert_eq!(p.source, PlanSource::Llm { repairs: 1 });
+    let reask = &reqs[1].messages.last().unwrap().content;
+    assert!(reask.contains("not_visited: true"), "{reask}");
+    assert_eq!(
+        stop,
+        StopTarget::Instance(1),
+        "the red sofa, the one not visited"
+    );
+    let first =
+        "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{visited: 1}));\n";
+    let (p, _, stop) = turn(
+        "ok go back to the sofa you visited first",
+        &[first],
+        &mut robot,
+    );
+    assert_eq!(p.source, PlanSource::Llm { repairs: 0 });
+    assert_eq!(
+        stop,
+        StopTarget::Instance(2),
+        "the black sofa, visited first"
+    );
+}
