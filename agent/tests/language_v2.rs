@@ -11,7 +11,7 @@
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
 
-use agent::v2::answer::parse_answer;
+use agent::v2::answer::{parse_answer, AnswerError};
 use agent::v2::grammar::Vocabulary;
 use agent::{plan_instruction, Outcome, PlanContext, PlanSource, Prompts, Session};
 use llm::{
@@ -19,7 +19,7 @@ use llm::{
     LlmError, Role,
 };
 use map_core::{IvlMap, Scene, SimRobot};
-use planner_dsl::typed::TypedPlan;
+use planner_dsl::typed::{TypedError, TypedPlan};
 use planner_dsl::Limits;
 
 fn flat_a() -> Arc<IvlMap> {
@@ -486,12 +486,25 @@ fn smollm2_answers_follow_the_grammar_built_from_the_map() {
         *spy.continued.lock().unwrap() >= 1,
         "no plan continued its objects line"
     );
+    let mut parsed = 0;
     for c in &answers {
         let text = match c.finish_reason {
             FinishReason::Length => c.text.rsplit_once('\n').map_or("", |(a, _)| a),
             _ => c.text.as_str(),
         };
-        let answer = parse_answer(text).unwrap_or_else(|e| panic!("{:?}: {e}", c.text));
+        // A variable's binding is the one thing a context-free grammar cannot hold (`var`
+        // is any name that is not a library call): an unbound one is the typed parse's
+        // to find, and the pipeline re-asks it as unreadable (SmolLM2 wrote `near:
+        // urn_of_brown_fle` once the worked examples grew at stop 47).
+        let answer = match parse_answer(text) {
+            Ok(a) => a,
+            Err(AnswerError::Plan {
+                source: TypedError::UnknownVariable { .. },
+                ..
+            }) => continue,
+            Err(e) => panic!("{:?}: {e}", c.text),
+        };
+        parsed += 1;
         assert!(!answer.plan.steps.is_empty(), "{:?}", c.text);
         for s in &answer.plan.steps {
             for t in s.targets() {
@@ -499,6 +512,7 @@ fn smollm2_answers_follow_the_grammar_built_from_the_map() {
             }
         }
     }
+    assert!(parsed >= 1, "no answer read as a typed plan: {answers:?}");
 }
 
 #[test]
