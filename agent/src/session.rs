@@ -107,10 +107,8 @@ impl Session {
             for id in &t.visited {
                 if let Some(i) = map.instance_by_id(*id) {
                     visited.push(format!(
-                        "{} {} ({}) in turn {}",
-                        i.label,
-                        i.id,
-                        i.colour.as_deref().unwrap_or("unknown colour"),
+                        "{} in turn {}",
+                        crate::v2::check::instance_words(i),
                         k + 1
                     ));
                 }

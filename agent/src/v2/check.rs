@@ -966,6 +966,16 @@ pub(crate) fn return_said(instruction: &str) -> bool {
     })
 }
 
+/// An instance as the conversation's references name it: "chair 9 (red)".
+pub(crate) fn instance_words(i: &map_core::Instance) -> String {
+    format!(
+        "{} {} ({})",
+        i.label,
+        i.id,
+        i.colour.as_deref().unwrap_or("unknown colour")
+    )
+}
+
 /// What a chat reference says of the object it means: visited earlier ("the bench you
 /// visited first", "that same chair", "the chair again") or not ("the other counter",
 /// "the lamp you haven't been to yet").
@@ -997,15 +1007,15 @@ fn visit_references(
     for (i, word) in w.iter().enumerate() {
         let before = |n: usize| &w[i.saturating_sub(n)..i];
         match word.as_str() {
-            "other" | "another" | "different" | "remaining" => {
+            "other" | "another" | "different" | "remaining" | "same" | "previous" => {
+                let v = if matches!(word.as_str(), "same" | "previous") {
+                    Visit::Earlier
+                } else {
+                    Visit::NotYet
+                };
                 let label = noun_after(map, &w, i, pose).map(|(_, l)| l);
                 let one = (i + 1..(i + 4).min(w.len())).any(one_at);
-                push(format!("{word} {}", at(i + 1)), Visit::NotYet, label, one);
-            }
-            "same" | "previous" => {
-                let label = noun_after(map, &w, i, pose).map(|(_, l)| l);
-                let one = (i + 1..(i + 4).min(w.len())).any(one_at);
-                push(format!("{word} {}", at(i + 1)), Visit::Earlier, label, one);
+                push(format!("{word} {}", at(i + 1)), v, label, one);
             }
             "again" => {
                 let label = noun_before(map, &w, i, pose);
@@ -1088,16 +1098,7 @@ fn check_visits(
         let ids: Vec<String> = refs
             .iter()
             .filter(|id| of(id, label))
-            .filter_map(|id| {
-                map.instance_by_id(*id).map(|i| {
-                    format!(
-                        "{} {} ({})",
-                        i.label,
-                        i.id,
-                        i.colour.as_deref().unwrap_or("unknown colour")
-                    )
-                })
-            })
+            .filter_map(|id| map.instance_by_id(*id).map(instance_words))
             .collect();
         if ids.is_empty() {
             "none".to_string()

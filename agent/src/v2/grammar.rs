@@ -1126,13 +1126,24 @@ pub(crate) mod tests {
         v
     }
 
+    /// [`vocab`] in a conversation that visited instances 4 and 9.
+    fn conversation() -> Vocabulary {
+        let mut v = vocab();
+        v.ids = vec![4, 9];
+        v
+    }
+
+    /// An answer that goes to the red chair picked with the selection keys `sel`.
+    fn red_chair_pick(sel: &str) -> String {
+        format!(
+            "objects: [(chair, None, red)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));"
+        )
+    }
+
     #[test]
     fn the_other_one_leaves_out_a_visited_instance_last() {
-        let mut conversation = vocab();
-        conversation.ids = vec![4, 9];
-        let pick = |sel: &str| {
-            format!("objects: [(chair, None, red)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));")
-        };
+        let conversation = conversation();
+        let pick = red_chair_pick;
         assert_offers(
             &answer_lark(&conversation),
             pick,
@@ -1169,11 +1180,8 @@ pub(crate) mod tests {
 
     #[test]
     fn visits_are_counted_only_in_a_conversation_and_never_with_an_ordinal() {
-        let mut conversation = vocab();
-        conversation.ids = vec![4, 9];
-        let pick = |sel: &str| {
-            format!("objects: [(chair, None, red)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));")
-        };
+        let conversation = conversation();
+        let pick = red_chair_pick;
         assert_offers(
             &answer_lark(&conversation),
             pick,
