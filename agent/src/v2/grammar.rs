@@ -369,7 +369,7 @@ fn arg_rule(ty: ParamType) -> &'static str {
 
 /// The call rule of a registered function: `"name(" args ")"`, optional parameters
 /// optional. `None` when the registry does not hold it.
-fn call_rule(name: &str) -> Option<String> {
+fn call_rule(name: &str, obj: &str) -> Option<String> {
     let f = planner_dsl::lookup(name)?;
     let mut r = q(&format!("{name}("));
     let mut first = true;
@@ -377,7 +377,10 @@ fn call_rule(name: &str) -> Option<String> {
     for p in f.params {
         let sep = if first { "" } else { ", " };
         first = false;
-        let rule = arg_rule(p.ty);
+        let rule = match p.ty {
+            ParamType::Object => obj,
+            ty => arg_rule(ty),
+        };
         if p.optional {
             r.push_str(" (");
             open += 1;
@@ -504,7 +507,7 @@ impl SelKeys<'_> {
             }
         }
         if open(KEY_NEAR) {
-            out.push(("\"near: \" obj".into(), after(KEY_NEAR, s.pending)));
+            out.push(("\"near: \" objn".into(), after(KEY_NEAR, s.pending)));
         }
         // A required colour key comes first, or right after the ordinal (the worked
         // examples' order). Measured on held-out v2 (dev): required anywhere, the default
@@ -767,47 +770,82 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     // statements before it are others (`stmt_nr`), so the grammar stays unambiguous and
     // offers the model the same tokens as without it, except the end of the plan before
     // a move back.
+    // A plan variable is offered only after a `let` has bound one: the statements before
+    // the first `let` are of the `...n` rules, whose objects (`objn`) are picks, names
+    // and ids, never a variable. A context-free grammar cannot hold which name was
+    // bound (the typed parse finds a misspelt one), but it can hold that one was: CI
+    // caught SmolLM2 writing `near: urn_of_brown_fle` in a plan with no `let`.
     let stmts = if vocab.return_required {
-        "(stmt_nr \"\\n\"){0,15} ret (\"\\n\" stmt){0,15}"
+        concat!(
+            "(stmt_nrn \"\\n\"){0,15} retn (\"\\n\" stmtn){0,15}",
+            " | (stmt_nrn \"\\n\"){0,15} letstmt (\"\\n\" stmt_nr){0,15} \"\\n\" ret (\"\\n\" stmt){0,15}",
+            " | (stmt_nrn \"\\n\"){0,15} retn (\"\\n\" stmtn){0,14} \"\\n\" letstmt (\"\\n\" stmt){0,15}"
+        )
     } else {
-        "stmt (\"\\n\" stmt){0,15}"
+        "stmtn (\"\\n\" stmtn){0,15} | (stmtn \"\\n\"){0,15} letstmt (\"\\n\" stmt){0,15}"
     };
     match part {
         Part::Whole => {
-            w.rule("root", &format!("objects \"\\nplan:\\n\" {stmts}"));
+            w.rule("root", &format!("objects \"\\nplan:\\n\" ({stmts})"));
             objects_rules(&mut w, vocab, &map_names(vocab));
         }
         Part::Plan => w.rule("root", stmts),
     }
-    let steps: Vec<String> = STEP_FUNCTIONS.iter().filter_map(|n| call_rule(n)).collect();
     // What a statement may follow (`stmt`, and `stmt_nr` and `ret` below).
     let comment = if vocab.comments {
         // Each statement may follow a comment line quoting the person's words it carries
         // out (as the worked examples of such a prompt set do). Comments do not reach the
         // plan: Rhai drops them, the typed plan has none.
-        w.rule("stmt", "(comment \"\\n\")? (letstmt | step)");
         let text = w.pattern("[^\\n]{1,120}", "[^\\n]{1,120}");
         w.rule("comment", &format!("\"// \" {text}"));
         "(comment \"\\n\")? "
     } else {
-        w.rule("stmt", "letstmt | step");
         ""
     };
-    w.rule("letstmt", "\"let \" var \" = \" pick \";\"");
-    w.rule("step", &format!("({}) \";\"", steps.join(" | ")));
-    if vocab.return_required {
-        let (back, other): (Vec<&str>, Vec<&str>) = STEP_FUNCTIONS
+    w.rule(
+        "letstmt",
+        &format!("{comment}\"let \" var \" = \" pick \";\""),
+    );
+    // Each statement rule twice: with a variable on offer (`obj`) and without (`objn`).
+    for (sfx, obj) in [("", "obj"), ("n", "objn")] {
+        let steps: Vec<String> = STEP_FUNCTIONS
             .iter()
-            .copied()
-            .partition(|n| RETURN_FUNCTIONS.contains(n));
-        let rules =
-            |names: Vec<&str>| -> Vec<String> { names.into_iter().filter_map(call_rule).collect() };
-        w.rule("stmt_nr", &format!("{comment}(letstmt | step_nr)"));
-        w.rule("step_nr", &format!("({}) \";\"", rules(other).join(" | ")));
+            .filter_map(|n| call_rule(n, obj))
+            .collect();
         w.rule(
-            "ret",
-            &format!("{comment}({}) \";\"", rules(back).join(" | ")),
+            &format!("step{sfx}"),
+            &format!("({}) \";\"", steps.join(" | ")),
         );
+        if sfx.is_empty() {
+            w.rule("stmt", &format!("letstmt | {comment}step"));
+        } else {
+            w.rule("stmtn", &format!("{comment}stepn"));
+        }
+        if vocab.return_required {
+            let (back, other): (Vec<&str>, Vec<&str>) = STEP_FUNCTIONS
+                .iter()
+                .copied()
+                .partition(|n| RETURN_FUNCTIONS.contains(n));
+            let rules = |names: Vec<&str>| -> Vec<String> {
+                names
+                    .into_iter()
+                    .filter_map(|n| call_rule(n, obj))
+                    .collect()
+            };
+            if sfx.is_empty() {
+                w.rule("stmt_nr", &format!("letstmt | {comment}step_nr"));
+            } else {
+                w.rule("stmt_nrn", &format!("{comment}step_nrn"));
+            }
+            w.rule(
+                &format!("step_nr{sfx}"),
+                &format!("({}) \";\"", rules(other).join(" | ")),
+            );
+            w.rule(
+                &format!("ret{sfx}"),
+                &format!("{comment}({}) \";\"", rules(back).join(" | ")),
+            );
+        }
     }
     // A variable is never named like a library call (`get_...`): measured on
     // people.nav (dev) ob4, with any identifier on offer the default model wrote
@@ -840,11 +878,15 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         }
         _ => w.rule("pick", &format!("{get} pname (\", \" selmap)? \")\"")),
     }
+    // An anchor (`near:`) is never a variable: it is written inside a pick, where the
+    // grammar does not know whether a `let` came before.
     if vocab.ids.is_empty() {
         w.rule("obj", "pick | qname | var");
+        w.rule("objn", "pick | qname");
     } else {
         let ids: Vec<String> = vocab.ids.iter().map(u32::to_string).collect();
         w.rule("obj", "pick | qname | var | inst");
+        w.rule("objn", "pick | qname | inst");
         w.rule(
             "inst",
             &format!("\"get_instance(\" ({}) \")\"", alt(&ids, false)),
@@ -1411,15 +1453,67 @@ pub(crate) mod tests {
             ],
             &["get_", "get_instance_by_", "get_obj", "Chair", "2nd"],
         );
-        // Where an object goes, what starts `get_` is a pick.
-        let used =
-            |obj: &str| format!("objects: [(chair, None, None)]\nplan:\nmove_to_object({obj});");
+        // Where an object goes, what starts `get_` is a pick (a `let` first, so that a
+        // variable is on offer there).
+        let used = |obj: &str| {
+            format!("objects: [(chair, None, None)]\nplan:\nlet chair = get_obj(\"sofa\");\nmove_to_object({obj});")
+        };
         assert_offers(
             &lark,
             used,
             &["get_obj(\"chair\")", "chair"],
             &["get_instance_by_id", "get_chair"],
         );
+    }
+
+    #[test]
+    fn a_variable_is_offered_only_after_a_let() {
+        let v = vocab();
+        let plan = |body: &str| format!("objects: [(chair, None, None)]\nplan:\n{body}");
+        let bound = "let c = get_obj(\"chair\");";
+        let go = "move_to_object(get_obj(\"chair\"));";
+        let ok = [
+            format!("{bound}\nmove_to_object(c);"),
+            format!("{go}\n{bound}\nface(c);\n{go}"),
+            format!("{go}\n{go}"),
+        ];
+        let bad = [
+            "move_to_object(c);".to_string(),
+            format!("{go}\nface(c);\n{bound}"),
+            // An anchor is a pick, a name or an id, never a variable.
+            format!("{bound}\nmove_to_object(get_obj(\"chair\", #{{near: c}}));"),
+        ];
+        for (name, lark, req) in [
+            ("plain", answer_lark(&v), false),
+            (
+                "a move back required",
+                answer_lark(&Vocabulary {
+                    return_required: true,
+                    ..v.clone()
+                }),
+                true,
+            ),
+        ] {
+            let back = if req { "\nmove_to_start();" } else { "" };
+            for body in &ok {
+                let text = plan(&format!("{body}{back}"));
+                lark_accepts(&lark, &text)
+                    .unwrap_or_else(|e| panic!("{name}: refused {text:?}: {e}"));
+            }
+            for body in &bad {
+                let text = plan(&format!("{body}{back}"));
+                assert!(
+                    lark_accepts(&lark, &text).is_err(),
+                    "{name}: offered {text:?}"
+                );
+            }
+            if req {
+                // The `let` may come after the move back, too.
+                let text = plan(&format!("{go}\nmove_to_start();\n{bound}\nface(c);"));
+                lark_accepts(&lark, &text)
+                    .unwrap_or_else(|e| panic!("{name}: refused {text:?}: {e}"));
+            }
+        }
     }
 
     #[test]
