@@ -33,7 +33,8 @@ use self::answer::{objects_part, parse_answer, Answer};
 use self::check::{check_answer_after, runtime_finding, Finding, FindingKind};
 use self::grammar::{
     answer_grammar, answer_lark, answer_objects_grammar, answer_objects_lark, group_list,
-    label_names, name_groups, objects_grammar, objects_lark, plan_grammar, plan_lark, Vocabulary,
+    label_names, name_groups, objects_grammar, objects_lark, plan_grammar, plan_lark, words_said,
+    Vocabulary,
 };
 
 /// The messages of one request: system (+ scene), the nearest worked examples, the
@@ -84,7 +85,10 @@ pub fn extract(
     );
     req.stop = vec!["\n".into()];
     if options.answer_grammar {
-        let mut vocab = Vocabulary::default();
+        let mut vocab = Vocabulary {
+            said_words: words_said(instruction),
+            ..Vocabulary::default()
+        };
         if options.said_only {
             narrow_orders(&mut vocab, instruction);
         }
@@ -391,6 +395,7 @@ pub fn plan_instruction(
     let vocab = {
         let mut v = Vocabulary::for_map(ctx.map);
         v.ids.clone_from(&ctx.references);
+        v.said_words = words_said(instruction);
         v.comments = quotes_words(prompts.example_index()?.examples());
         if ctx.options.said_only {
             narrow_to_words(
