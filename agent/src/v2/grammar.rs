@@ -76,20 +76,17 @@ pub struct Vocabulary {
     pub said_words: Vec<String>,
 }
 
-/// The words of `instruction`, lower-case, split at anything but a letter or `-`, each
-/// once: [`Vocabulary::said_words`].
+/// The words of `instruction` as the language layer splits them ([`crate::words::words`]),
+/// each once, those an object word can be (letters a-z and `-`):
+/// [`Vocabulary::said_words`].
 #[must_use]
 pub fn words_said(instruction: &str) -> Vec<String> {
-    let mut out: Vec<String> = Vec::new();
-    for w in instruction
-        .to_lowercase()
-        .split(|c: char| !(c.is_ascii_lowercase() || c == '-'))
-        .filter(|w| !w.is_empty())
-    {
-        if !out.iter().any(|o| o == w) {
-            out.push(w.to_string());
-        }
-    }
+    let mut out: Vec<String> = crate::words::words(instruction)
+        .into_iter()
+        .filter(|w| w.chars().all(|c| c.is_ascii_lowercase() || c == '-'))
+        .collect();
+    out.sort();
+    out.dedup();
     out
 }
 
