@@ -74,6 +74,9 @@ pub struct Vocabulary {
     /// of them as an object even where it begins with a colour word ("whiteboard"), which
     /// a word the model made up may not ("greycouch").
     pub said_words: Vec<String>,
+    /// A tuple's colour on the objects line is one the person said (or a synonym of
+    /// one), or `None`; the plan's selections are not narrowed by this.
+    pub said_tuple_colours: bool,
 }
 
 /// The words of `instruction` as the language layer splits them ([`crate::words::words`]),
@@ -168,6 +171,7 @@ impl Vocabulary {
             comments: false,
             return_required: false,
             said_words: Vec::new(),
+            said_tuple_colours: false,
         }
     }
 }
@@ -362,7 +366,25 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
     }
     let n = w.pattern("[1-9] [0-9]?", "[1-9][0-9]?");
     w.rule("tordinal", &format!("\"None\" | \"last\" | {n}"));
-    w.rule("tcolour", &format!("\"None\" | {}", alt(&colours, false)));
+    let tcolours: Vec<&String> = if vocab.said_tuple_colours {
+        colours
+            .iter()
+            .filter(|c| {
+                let c = map_core::matcher::canonical(c);
+                vocab
+                    .said_words
+                    .iter()
+                    .any(|w| map_core::matcher::canonical(w) == c)
+            })
+            .collect()
+    } else {
+        colours.iter().collect()
+    };
+    if tcolours.is_empty() {
+        w.rule("tcolour", "\"None\"");
+    } else {
+        w.rule("tcolour", &format!("\"None\" | {}", alt(&tcolours, false)));
+    }
 }
 
 fn objects_only(d: Dialect, vocab: &Vocabulary, map_names: &[String]) -> String {
@@ -1467,6 +1489,41 @@ pub(crate) mod tests {
         ] {
             assert!(lark_accepts(&only, &line(bad)).is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn said_tuple_colours_offers_only_the_colours_the_person_said() {
+        let mut v = vocab();
+        v.said_words = words_said("the plant by the Grey sofa, then the lamp");
+        v.said_tuple_colours = true;
+        let lark = answer_lark(&v);
+        assert!(undefined_rules(&answer_grammar(&v)).is_empty());
+        let answer =
+            |t: &str| format!("objects: [{t}]\nplan:\nmove_to_object(get_obj(\"chair\"));");
+        // "grey" said: either spelling; any other colour is not on offer.
+        for ok in [
+            "(sofa, None, gray)",
+            "(sofa, None, grey)",
+            "(lamp, None, None)",
+        ] {
+            lark_accepts(&lark, &answer(ok)).unwrap_or_else(|e| panic!("{ok}: {e}"));
+        }
+        for bad in [
+            "(lamp, None, black)",
+            "(plant, None, green)",
+            "(sofa, None, red)",
+        ] {
+            assert!(lark_accepts(&lark, &answer(bad)).is_err(), "{bad}");
+        }
+        // The plan's selections are not narrowed: a colour of the map stays on offer.
+        let plan = "objects: [(lamp, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{colour: \"red\"}));";
+        lark_accepts(&lark, plan).unwrap();
+        // No colour said: `None` only.
+        v.said_words = words_said("go to the lamp");
+        let only = objects_lark(&v);
+        let line = |t: &str| format!("objects: [{t}]\n");
+        lark_accepts(&only, &line("(lamp, None, None)")).unwrap();
+        assert!(lark_accepts(&only, &line("(lamp, None, black)")).is_err());
     }
 
     #[test]

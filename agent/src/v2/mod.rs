@@ -87,6 +87,7 @@ pub fn extract(
     if options.answer_grammar {
         let mut vocab = Vocabulary {
             said_words: words_said(instruction),
+            said_tuple_colours: options.said_tuple_colours,
             ..Vocabulary::default()
         };
         if options.said_only {
@@ -396,6 +397,7 @@ pub fn plan_instruction(
         let mut v = Vocabulary::for_map(ctx.map);
         v.ids.clone_from(&ctx.references);
         v.said_words = words_said(instruction);
+        v.said_tuple_colours = ctx.options.said_tuple_colours;
         v.comments = quotes_words(prompts.example_index()?.examples());
         if ctx.options.said_only {
             narrow_to_words(
