@@ -74,9 +74,11 @@ pub struct Vocabulary {
     /// of them as an object even where it begins with a colour word ("whiteboard"), which
     /// a word the model made up may not ("greycouch").
     pub said_words: Vec<String>,
-    /// A tuple's colour on the objects line is one the person said (or a synonym of
-    /// one), or `None`; the plan's selections are not narrowed by this.
-    pub said_tuple_colours: bool,
+    /// The colours a tuple on the objects line may carry besides `None` (unset: every
+    /// colour word and every colour of `colours`): with `--said-tuple-colours`, those the person said as
+    /// [`check::colour_said`](super::check) reads them (`said_tuple_colours` in
+    /// `v2/mod.rs`). The plan's selections are not narrowed by this.
+    pub tuple_colours: Option<Vec<String>>,
 }
 
 /// The words of `instruction` as the language layer splits them ([`crate::words::words`]),
@@ -171,7 +173,7 @@ impl Vocabulary {
             comments: false,
             return_required: false,
             said_words: Vec::new(),
-            said_tuple_colours: false,
+            tuple_colours: None,
         }
     }
 }
@@ -293,9 +295,7 @@ fn offered_orders(vocab: &Vocabulary, with_default: bool) -> Vec<&'static str> {
 /// counter" as `left_to_right`, "the black chair nearest the desk" with the desk
 /// `largest_to_smallest`).
 fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
-    let mut colours: Vec<String> = COLOUR_WORDS.iter().map(|s| (*s).to_string()).collect();
-    colours.extend(vocab.colours.iter().cloned());
-    colours.retain(|c| !c.trim().is_empty());
+    let colours = tuple_colour_words(vocab);
     // Empty when the person names no object ("turn around", "go back to where we
     // started"); at most 16 objects, as many as a plan's statements, so that a weak model
     // that repeats a tuple stops (SmolLM2 listed `(desk, 1, None)` to the token limit).
@@ -366,19 +366,9 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
     }
     let n = w.pattern("[1-9] [0-9]?", "[1-9][0-9]?");
     w.rule("tordinal", &format!("\"None\" | \"last\" | {n}"));
-    let tcolours: Vec<&String> = if vocab.said_tuple_colours {
-        colours
-            .iter()
-            .filter(|c| {
-                let c = map_core::matcher::canonical(c);
-                vocab
-                    .said_words
-                    .iter()
-                    .any(|w| map_core::matcher::canonical(w) == c)
-            })
-            .collect()
-    } else {
-        colours.iter().collect()
+    let tcolours: Vec<&String> = match &vocab.tuple_colours {
+        Some(offered) => colours.iter().filter(|c| offered.contains(c)).collect(),
+        None => colours.iter().collect(),
     };
     if tcolours.is_empty() {
         w.rule("tcolour", "\"None\"");
@@ -395,6 +385,14 @@ fn objects_only(d: Dialect, vocab: &Vocabulary, map_names: &[String]) -> String 
     w.rule("root", "objects \"\\n\"");
     objects_rules(&mut w, vocab, map_names);
     w.out
+}
+
+/// The colour words of the objects line: every colour word, and `vocab`'s colours.
+pub(crate) fn tuple_colour_words(vocab: &Vocabulary) -> Vec<String> {
+    let mut colours: Vec<String> = COLOUR_WORDS.iter().map(|s| (*s).to_string()).collect();
+    colours.extend(vocab.colours.iter().cloned());
+    colours.retain(|c| !c.trim().is_empty());
+    colours
 }
 
 /// GBNF for the objects line alone (extraction without a map: `vocab`'s colours and
@@ -1494,8 +1492,11 @@ pub(crate) mod tests {
     #[test]
     fn said_tuple_colours_offers_only_the_colours_the_person_said() {
         let mut v = vocab();
-        v.said_words = words_said("the plant by the Grey sofa, then the lamp");
-        v.said_tuple_colours = true;
+        let base = v.clone();
+        let said = |instruction: &str, known: &[String]| {
+            Some(super::super::said_tuple_colours(&base, instruction, known))
+        };
+        v.tuple_colours = said("the plant by the Grey sofa, then the lamp", &[]);
         let lark = answer_lark(&v);
         assert!(undefined_rules(&answer_grammar(&v)).is_empty());
         let answer =
@@ -1519,11 +1520,19 @@ pub(crate) mod tests {
         let plan = "objects: [(lamp, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{colour: \"red\"}));";
         lark_accepts(&lark, plan).unwrap();
         // No colour said: `None` only.
-        v.said_words = words_said("go to the lamp");
+        v.tuple_colours = said("go to the lamp", &[]);
         let only = objects_lark(&v);
         let line = |t: &str| format!("objects: [{t}]\n");
         lark_accepts(&only, &line("(lamp, None, None)")).unwrap();
         assert!(lark_accepts(&only, &line("(lamp, None, black)")).is_err());
+        // Said as the checks read it: a typed colour, and a colour of what the
+        // conversation visited.
+        v.tuple_colours = said("the gren plant", &["black".to_string()]);
+        let typed = objects_lark(&v);
+        for ok in ["(plant, None, green)", "(lamp, None, black)"] {
+            lark_accepts(&typed, &line(ok)).unwrap_or_else(|e| panic!("{ok}: {e}"));
+        }
+        assert!(lark_accepts(&typed, &line("(lamp, None, red)")).is_err());
     }
 
     #[test]

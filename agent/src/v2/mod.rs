@@ -87,9 +87,11 @@ pub fn extract(
     if options.answer_grammar {
         let mut vocab = Vocabulary {
             said_words: words_said(instruction),
-            said_tuple_colours: options.said_tuple_colours,
             ..Vocabulary::default()
         };
+        if options.said_tuple_colours {
+            vocab.tuple_colours = Some(said_tuple_colours(&vocab, instruction, &[]));
+        }
         if options.said_only {
             narrow_orders(&mut vocab, instruction);
         }
@@ -248,6 +250,22 @@ fn narrow_orders(v: &mut Vocabulary, instruction: &str) {
     v.no_far_end = !check::far_end_said(instruction);
 }
 
+/// The objects line's colour words ([`grammar::tuple_colour_words`]) said by
+/// `instruction` or `known` as the checks read them ([`check::colour_said`]: a typed
+/// colour counts, and grey is gray): with `--said-tuple-colours`, the colours a tuple on
+/// the objects line may carry ([`Vocabulary::tuple_colours`]).
+pub(crate) fn said_tuple_colours(
+    vocab: &Vocabulary,
+    instruction: &str,
+    known: &[String],
+) -> Vec<String> {
+    let said = check::colour_said(instruction, known);
+    grammar::tuple_colour_words(vocab)
+        .into_iter()
+        .filter(|c| said(c))
+        .collect()
+}
+
 /// Per object name, the colours the person said that some object of that name has on
 /// this map ([`check::colour_said`]: a typo counts), as groups of names (a label and its
 /// synonyms) sharing one list; a name's first group wins.
@@ -397,7 +415,10 @@ pub fn plan_instruction(
         let mut v = Vocabulary::for_map(ctx.map);
         v.ids.clone_from(&ctx.references);
         v.said_words = words_said(instruction);
-        v.said_tuple_colours = ctx.options.said_tuple_colours;
+        if ctx.options.said_tuple_colours {
+            let known = check::known_colours(ctx.map, &ctx.references, ctx.earlier.as_deref());
+            v.tuple_colours = Some(said_tuple_colours(&v, instruction, &known));
+        }
         v.comments = quotes_words(prompts.example_index()?.examples());
         if ctx.options.said_only {
             narrow_to_words(
