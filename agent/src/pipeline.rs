@@ -97,7 +97,8 @@ pub struct PlanOptions {
     /// With `said_only`, outside a conversation: a pick of each object may select only
     /// on the colours the person said that some object of that name has on this map.
     pub said_colours: bool,
-    /// The objects line's colours are the person's (`--said-tuple-colours`; default off).
+    /// The objects line's colours are the person's (default on; `--any-tuple-colours`
+    /// turns it off).
     pub said_tuple_colours: bool,
     /// Answers drawn again after the greedy answer and the re-ask still disagree with
     /// the checks, before the person is asked (default 1): each is the re-ask's request
@@ -137,7 +138,7 @@ impl Default for PlanOptions {
             llguidance: true,
             said_only: true,
             said_colours: false,
-            said_tuple_colours: false,
+            said_tuple_colours: true,
             redraws: 1,
             redraw_temperature: 0.7,
             reversed_draw: true,

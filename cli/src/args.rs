@@ -269,10 +269,10 @@ pub(crate) struct ModelArgs {
     /// has on the map (outside a conversation; for comparison).
     #[arg(long, conflicts_with = "open_selections")]
     pub(crate) said_colours: bool,
-    /// Hold each tuple's colour on the objects line to a colour the person said (for
-    /// comparison).
+    /// Let a tuple on the objects line carry any colour word, not only a colour the
+    /// person said (the default before stop 51; for comparison).
     #[arg(long)]
-    pub(crate) said_tuple_colours: bool,
+    pub(crate) any_tuple_colours: bool,
     /// After the re-ask still disagrees with the checks, draw up to N more answers
     /// (sampled, seeds 1..N) before asking the person; the first the checks accept is
     /// the plan.
@@ -330,7 +330,7 @@ impl ModelArgs {
             answer_grammar: !self.no_grammar,
             said_only: !self.open_selections,
             said_colours: self.said_colours,
-            said_tuple_colours: self.said_tuple_colours,
+            said_tuple_colours: !self.any_tuple_colours,
             redraws: self.redraws,
             redraw_temperature: self.redraw_temperature,
             reversed_draw: !self.no_reversed_draw,

@@ -252,7 +252,7 @@ fn narrow_orders(v: &mut Vocabulary, instruction: &str) {
 
 /// The objects line's colour words ([`grammar::tuple_colour_words`]) said by
 /// `instruction` or `known` as the checks read them ([`check::colour_said`]: a typed
-/// colour counts, and grey is gray): with `--said-tuple-colours`, the colours a tuple on
+/// colour counts, and grey is gray): by default, the colours a tuple on
 /// the objects line may carry ([`Vocabulary::tuple_colours`]).
 pub(crate) fn said_tuple_colours(
     vocab: &Vocabulary,
