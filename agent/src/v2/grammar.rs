@@ -75,7 +75,8 @@ pub struct Vocabulary {
     /// a word the model made up may not ("greycouch").
     pub said_words: Vec<String>,
     /// The colours a tuple on the objects line may carry besides `None` (unset: every
-    /// colour word and every colour of `colours`): by default (`PlanOptions::said_tuple_colours`), those the person said as
+    /// colour word and every colour of `colours`). By default
+    /// (`PlanOptions::said_tuple_colours`), those the person said as
     /// [`check::colour_said`](super::check) reads them (`said_tuple_colours` in
     /// `v2/mod.rs`). The plan's selections are not narrowed by this.
     pub tuple_colours: Option<Vec<String>>,

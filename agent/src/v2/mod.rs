@@ -252,8 +252,8 @@ fn narrow_orders(v: &mut Vocabulary, instruction: &str) {
 
 /// The objects line's colour words ([`grammar::tuple_colour_words`]) said by
 /// `instruction` or `known` as the checks read them ([`check::colour_said`]: a typed
-/// colour counts, and grey is gray): by default, the colours a tuple on
-/// the objects line may carry ([`Vocabulary::tuple_colours`]).
+/// colour counts, and grey is gray): by default, the colours a tuple on the objects line
+/// may carry ([`Vocabulary::tuple_colours`]).
 pub(crate) fn said_tuple_colours(
     vocab: &Vocabulary,
     instruction: &str,
