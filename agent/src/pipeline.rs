@@ -100,6 +100,10 @@ pub struct PlanOptions {
     /// The objects line's colours are the person's (default on; `--any-tuple-colours`
     /// turns it off).
     pub said_tuple_colours: bool,
+    /// A pick selects only on the colours its objects have on the map, and excludes
+    /// only one that tells them apart (default on; `--any-pick-colours` turns it off):
+    /// [`Vocabulary::map_colours`](crate::v2::grammar::Vocabulary::map_colours).
+    pub map_colours: bool,
     /// Answers drawn again after the greedy answer and the re-ask still disagree with
     /// the checks, before the person is asked (default 1): each is the re-ask's request
     /// (the first request with `reask` off) sampled at `redraw_temperature` with its
@@ -139,6 +143,7 @@ impl Default for PlanOptions {
             said_only: true,
             said_colours: false,
             said_tuple_colours: true,
+            map_colours: true,
             redraws: 1,
             redraw_temperature: 0.7,
             reversed_draw: true,

@@ -273,6 +273,10 @@ pub(crate) struct ModelArgs {
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
     pub(crate) any_tuple_colours: bool,
+    /// Let a pick select on any colour of the map, not only one its objects have
+    /// (the default before stop 52; for comparison).
+    #[arg(long)]
+    pub(crate) any_pick_colours: bool,
     /// After the re-ask still disagrees with the checks, draw up to N more answers
     /// (sampled, seeds 1..N) before asking the person; the first the checks accept is
     /// the plan.
@@ -331,6 +335,7 @@ impl ModelArgs {
             said_only: !self.open_selections,
             said_colours: self.said_colours,
             said_tuple_colours: !self.any_tuple_colours,
+            map_colours: !self.any_pick_colours,
             redraws: self.redraws,
             redraw_temperature: self.redraw_temperature,
             reversed_draw: !self.no_reversed_draw,

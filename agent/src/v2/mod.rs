@@ -415,6 +415,9 @@ pub fn plan_instruction(
         let mut v = Vocabulary::for_map(ctx.map);
         v.ids.clone_from(&ctx.references);
         v.said_words = words_said(instruction);
+        if ctx.options.map_colours {
+            v.map_colours(ctx.map);
+        }
         if ctx.options.said_tuple_colours {
             let known = check::known_colours(ctx.map, &ctx.references, ctx.earlier.as_deref());
             v.tuple_colours = Some(said_tuple_colours(&v, instruction, &known));
