@@ -6,8 +6,10 @@
 //! functions ([`planner_dsl::typed::STEP_FUNCTIONS`], each with its registry signature)
 //! and pick objects only by the names, colours and regions this map holds, ordinals as
 //! integers, orders from map_core. A local model under it cannot call anything outside
-//! the library or name anything the map lacks; what it cannot say (a colour the map
-//! has no object in) the checks find in the objects line and ask about.
+//! the library or name anything the map lacks (by default not even a colour that no
+//! object of the picked name has: [`Vocabulary::map_colours`]); what it cannot say (a
+//! colour the map has no such object in) the checks find in the objects line and ask
+//! about.
 
 use map_core::matcher::{synonyms, COLOUR_WORDS};
 use map_core::{IvlMap, ObjectOrder};
@@ -1929,13 +1931,18 @@ pub(crate) mod tests {
         assert!(!g.contains("qregion"), "{g}");
     }
 
-    #[test]
-    fn a_pick_names_only_a_region_that_holds_an_object_of_its_name() {
+    /// The bundled example scene's map.
+    fn flat_a() -> IvlMap {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../examples/scenes/flat-a.scene.json"
         );
-        let map = IvlMap::from_scene(&map_core::scene::Scene::from_path(path).unwrap());
+        IvlMap::from_scene(&map_core::scene::Scene::from_path(path).unwrap())
+    }
+
+    #[test]
+    fn a_pick_names_only_a_region_that_holds_an_object_of_its_name() {
+        let map = flat_a();
         let v = Vocabulary::for_map(&map);
         let lark = answer_lark(&v);
         let gbnf = answer_grammar(&v);
@@ -1979,11 +1986,7 @@ pub(crate) mod tests {
 
     #[test]
     fn with_map_colours_a_pick_keeps_its_objects_colours_and_excludes_what_tells_them_apart() {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../examples/scenes/flat-a.scene.json"
-        );
-        let map = IvlMap::from_scene(&map_core::scene::Scene::from_path(path).unwrap());
+        let map = flat_a();
         let mut v = Vocabulary::for_map(&map);
         v.map_colours(&map);
         let lark = answer_lark(&v);
@@ -2040,11 +2043,7 @@ pub(crate) mod tests {
 
     #[test]
     fn vocabulary_of_a_scene() {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../examples/scenes/flat-a.scene.json"
-        );
-        let map = IvlMap::from_scene(&map_core::scene::Scene::from_path(path).unwrap());
+        let map = flat_a();
         let v = Vocabulary::for_map(&map);
         for n in ["sofa", "couch", "refrigerator", "fridge"] {
             assert!(v.names.iter().any(|x| x == n), "{n}: {:?}", v.names);

@@ -217,12 +217,14 @@ fn settle(findings: &[Finding]) -> Outcome {
 /// [`check::direction_said`], [`check::size_said`], [`check::far_end_said`]), so the
 /// grammar never offers what those checks would re-ask.
 ///
-/// Colours are not narrowed: measured on people.nav, the default model gives most
-/// objects a colour, and with only the said colours on offer it gave them a said colour
-/// of another object ("the lamp" as a black lamp after "the black sofa", on a map whose
-/// one lamp is white): four plans became questions while four others were gained. A
-/// colour narrowed per object (the said colours that object has on this map) would
-/// need one selection rule per colour set; until then the checks judge colours.
+/// Colours are not narrowed to the said ones: measured on people.nav, the default model
+/// gives most objects a colour, and with only the said colours on offer it gave them a
+/// said colour of another object ("the lamp" as a black lamp after "the black sofa", on
+/// a map whose one lamp is white): four plans became questions while four others were
+/// gained. Narrowed per object to the said colours it has (`said_colours`) measured
+/// worse too; the checks judge colours. What the map holds narrows them by default
+/// ([`Vocabulary::map_colours`], `PlanOptions::map_colours`): a pick selects only on
+/// its objects' colours.
 fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>) {
     let counts = check::counts_said(instruction);
     v.ordinals = Some(
