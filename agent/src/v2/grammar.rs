@@ -194,8 +194,8 @@ impl Vocabulary {
     /// colour some object of the label has and another lacks). Neither choice it takes
     /// away can run: `get_obj("sofa", #{colour: "yellow"})` on a map with no yellow sofa
     /// fails ("there is no yellow sofa"), and `#{not_colour: "white"}` where every desk is
-    /// white leaves no desk. Measured on held-out v2 (dev) before this: 22 such failures
-    /// in the answers of one run.
+    /// white leaves no desk. Measured on held-out v2 (dev) before this: the answers of
+    /// one run (stop 51) held 22 picks of the first kind and 3 of the second.
     pub fn map_colours(&mut self, map: &IvlMap) {
         let colours_of = |label: &str| -> Vec<Option<String>> {
             map.instances
@@ -633,8 +633,9 @@ impl SelKeys<'_> {
 
 /// The selection map `selmap{suffix}`: its keys in any order, each at most once, at
 /// least one (as a Rhai map literal takes them); colours from the rule `colour` (none:
-/// no colour keys) and excluded ones from `not_colour` (none: no `not_colour`), regions from the rule `region` (none: no region key). Its key rules
-/// are `sel{suffix}_{written}_{pending}`, one per state of [`SelState`] reached. In a
+/// no colour key) and excluded ones from `not_colour` (none: no `not_colour` key),
+/// regions from the rule `region` (none: no region key). Its key rules are
+/// `sel{suffix}_{written}_{pending}`, one per state of [`SelState`] reached. In a
 /// conversation (`vocab.ids`), `other_than: get_instance(id)`, `visited: k` (without an
 /// ordinal) or `not_visited: true` may end the map.
 ///
