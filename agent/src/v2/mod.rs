@@ -274,15 +274,8 @@ pub(crate) fn said_tuple_colours(
 fn colours_said_of(map: &map_core::IvlMap, instruction: &str) -> Vec<(Vec<String>, Vec<String>)> {
     let said = check::colour_said(instruction, &[]);
     name_groups(map, |label| {
-        let mut colours: Vec<String> = map
-            .instances
-            .iter()
-            .filter(|i| i.label == label)
-            .filter_map(|i| i.colour.clone())
-            .filter(|c| said(c))
-            .collect();
-        colours.sort();
-        colours.dedup();
+        let mut colours = grammar::label_colours(map, label);
+        colours.retain(|c| said(c));
         colours
     })
 }
