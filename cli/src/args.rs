@@ -273,8 +273,9 @@ pub(crate) struct ModelArgs {
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
     pub(crate) any_tuple_colours: bool,
-    /// Let a pick select on any colour of the map, not only one its objects have
-    /// (the default before stop 52; for comparison).
+    /// Let a pick select on any colour of the map, not only one its objects have, and
+    /// `move_between_the_two` name any object on any colour, not only a pair's (the
+    /// defaults before stops 52 and 53; for comparison).
     #[arg(long)]
     pub(crate) any_pick_colours: bool,
     /// After the re-ask still disagrees with the checks, draw up to N more answers

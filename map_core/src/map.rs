@@ -233,12 +233,21 @@ impl IvlMap {
     /// centroid inside the region, as a selection's `region` filter counts it), in the
     /// map's order of regions.
     pub fn regions_holding(&self, label: &str) -> Vec<&str> {
+        self.regions_holding_at_least(label, 1)
+    }
+
+    /// The names of the regions holding `n` or more instances labelled `label` (as
+    /// [`IvlMap::regions_holding`] counts them), in the map's order of regions: where
+    /// "the two chairs in the kitchen" can be found.
+    pub fn regions_holding_at_least(&self, label: &str, n: usize) -> Vec<&str> {
         self.regions
             .iter()
             .filter(|r| {
                 self.instances
                     .iter()
-                    .any(|i| i.label == label && r.polygon.contains(i.centroid))
+                    .filter(|i| i.label == label && r.polygon.contains(i.centroid))
+                    .count()
+                    >= n
             })
             .map(|r| r.name.as_str())
             .collect()
@@ -381,6 +390,9 @@ mod tests {
         // chair 2 at x = 1 is in the kitchen (x 0..3); chair 4 at x = 4 is not.
         assert_eq!(m.regions_holding("chair"), ["kitchen"]);
         assert!(m.regions_holding("table").is_empty());
+        // One chair in the kitchen: no region holds two.
+        assert!(m.regions_holding_at_least("chair", 2).is_empty());
+        assert_eq!(m.regions_holding_at_least("chair", 1), ["kitchen"]);
     }
 
     #[test]

@@ -59,6 +59,14 @@ pub struct Vocabulary {
     /// [`Vocabulary::map_colours`] gives each label the colours that tell its objects
     /// apart: one that every object of the name has leaves none to pick.
     pub not_colours_of: Option<Vec<(Vec<String>, Vec<String>)>>,
+    /// The names `move_between_the_two` may stop between two of, as groups of names
+    /// sharing the colours and regions such a pair may select on (`None`: every name,
+    /// on the lists of its picks). [`Vocabulary::map_colours`] gives each label with two
+    /// or more objects the colours two or more of them have, those two or more lack, and
+    /// the regions holding two or more: a name in no group has too few objects for a
+    /// pair. The colour lists are cut to the name's `colour` list, the regions to
+    /// the region keys.
+    pub pairs_of: Option<Vec<(Vec<String>, PairKeys)>>,
     /// The regions a selection's `region` key may name (`None`: every one of `regions`;
     /// empty: no `region` key). A bare region name ("go to the kitchen") stays any of
     /// `regions`.
@@ -89,6 +97,18 @@ pub struct Vocabulary {
     pub tuple_colours: Option<Vec<String>>,
 }
 
+/// The colours and regions a pair of objects of one name ("between the two yellow
+/// tables") may be selected on: [`Vocabulary::pairs_of`].
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct PairKeys {
+    /// Colours two or more objects of the name have (`colour:`).
+    pub colours: Vec<String>,
+    /// Colours two or more objects of the name lack (`not_colour:`).
+    pub not_colours: Vec<String>,
+    /// Regions holding two or more objects of the name (`region:`).
+    pub regions: Vec<String>,
+}
+
 /// The words of `instruction` as the language layer splits them (`words::words`),
 /// each once, those an object word can be (letters a-z and `-`):
 /// [`Vocabulary::said_words`].
@@ -105,11 +125,11 @@ pub fn words_said(instruction: &str) -> Vec<String> {
 
 /// The map's object names (each label with its synonyms) in groups sharing one list,
 /// `list_of(label)` for each label; a name's first label wins (a synonym of two labels).
-pub(crate) fn name_groups(
+pub(crate) fn name_groups<T: PartialEq>(
     map: &IvlMap,
-    list_of: impl Fn(&str) -> Vec<String>,
-) -> Vec<(Vec<String>, Vec<String>)> {
-    let mut groups: Vec<(Vec<String>, Vec<String>)> = Vec::new();
+    list_of: impl Fn(&str) -> T,
+) -> Vec<(Vec<String>, T)> {
+    let mut groups: Vec<(Vec<String>, T)> = Vec::new();
     let mut seen: Vec<String> = Vec::new();
     for (label, _) in map.label_counts() {
         let list = list_of(&label);
@@ -177,6 +197,7 @@ impl Vocabulary {
             colour_key_required: Vec::new(),
             colours_of: None,
             not_colours_of: None,
+            pairs_of: None,
             region_keys: None,
             regions_of: (!map.regions.is_empty()).then_some(regions_of),
             comments: false,
@@ -194,17 +215,49 @@ impl Vocabulary {
     /// fails ("there is no yellow sofa"), and `#{not_colour: "white"}` where every desk is
     /// white leaves no desk. Measured on held-out v2 (dev) before this: the answers of
     /// one run (stop 51) held 22 picks of the first kind and 3 of the second.
+    ///
+    /// So too for pairs ([`Vocabulary::pairs_of`]): "between the two yellow tables"
+    /// selects on a colour that two or more tables have, or lack, of a name with two or
+    /// more objects; anything else leaves fewer than two to stop between.
     pub fn map_colours(&mut self, map: &IvlMap) {
+        // How many objects labelled `label` have (`true`) or lack (`false`) colour `c`.
+        let count = |label: &str, c: &str, has: bool| {
+            map.instances
+                .iter()
+                .filter(|i| i.label == label && (i.colour.as_deref() == Some(c)) == has)
+                .count()
+        };
         self.colours_of = Some(name_groups(map, |label| label_colours(map, label)));
         self.not_colours_of = Some(name_groups(map, |label| {
             let mut list = label_colours(map, label);
-            list.retain(|c| {
-                map.instances
-                    .iter()
-                    .any(|i| i.label == label && i.colour.as_deref() != Some(c.as_str()))
-            });
+            list.retain(|c| count(label, c, false) > 0);
             list
         }));
+        let pairs = name_groups(map, |label| {
+            let objects = map.instances.iter().filter(|i| i.label == label).count();
+            (objects >= 2).then(|| {
+                let with = |has: bool| {
+                    let mut list = label_colours(map, label);
+                    list.retain(|c| count(label, c, has) >= 2);
+                    list
+                };
+                PairKeys {
+                    colours: with(true),
+                    not_colours: with(false),
+                    regions: map
+                        .regions_holding_at_least(label, 2)
+                        .into_iter()
+                        .map(str::to_string)
+                        .collect(),
+                }
+            })
+        });
+        self.pairs_of = Some(
+            pairs
+                .into_iter()
+                .filter_map(|(names, p)| Some((names, p?)))
+                .collect(),
+        );
     }
 }
 
@@ -470,16 +523,30 @@ fn arg_rule(ty: ParamType, obj: &str) -> &str {
 }
 
 /// The call rule of a registered function: `"name(" args ")"`, optional parameters
-/// optional. `None` when the registry does not hold it.
-fn call_rule(name: &str, obj: &str) -> Option<String> {
+/// optional. A name followed by a selection ("between the two yellow tables") is written
+/// by `namesel`, which holds the selection to what the name's objects offer a pair
+/// ([`Vocabulary::pairs_of`]); without `pairs` (no name has two objects) such a
+/// function is left out. `None` when the registry does not hold it, or it is left out.
+fn call_rule(name: &str, obj: &str, pairs: bool) -> Option<String> {
     let f = planner_dsl::lookup(name)?;
     let mut r = q(&format!("{name}("));
     let mut first = true;
     let mut open = 0;
-    for p in f.params {
+    let mut params = f.params.iter().peekable();
+    while let Some(p) = params.next() {
         let sep = if first { "" } else { ", " };
         first = false;
-        let rule = arg_rule(p.ty, obj);
+        let rule = if p.ty == ParamType::Name
+            && params.peek().is_some_and(|n| n.ty == ParamType::Selection)
+        {
+            if !pairs {
+                return None;
+            }
+            params.next();
+            "namesel"
+        } else {
+            arg_rule(p.ty, obj)
+        };
         if p.optional {
             r.push_str(" (");
             open += 1;
@@ -756,8 +823,16 @@ pub(crate) fn group_list(
 
 /// The pick groups of `vocab` ([`Vocabulary::colours_of`] and [`Vocabulary::regions_of`]
 /// joined, the region lists cut to the region keys): `None` when neither narrows a name.
-fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
-    if vocab.colours_of.is_none()
+///
+/// With `pairs`, the groups of the names `move_between_the_two` may name
+/// ([`Vocabulary::pairs_of`]; `None` when it is): those of no pair group are left out,
+/// and a group's colours are its pair's, cut to the name's `colour` list.
+fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
+    if pairs && vocab.pairs_of.is_none() {
+        return None;
+    }
+    if !pairs
+        && vocab.colours_of.is_none()
         && vocab.not_colours_of.is_none()
         && vocab.regions_of.is_none()
         && vocab.colour_required.is_empty()
@@ -768,18 +843,35 @@ fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
     let keys = region_keys(vocab);
     let mut groups: Vec<PickGroup> = Vec::new();
     for name in &vocab.names {
-        let colours = group_list(vocab.colours_of.as_deref(), name);
+        let mut colours = group_list(vocab.colours_of.as_deref(), name);
         // Cut to the colours a pick of the name may keep: a narrowed `colour` list (a
         // re-ask's bar) narrows what it may exclude as well.
-        let not_colours = group_list(vocab.not_colours_of.as_deref(), name).map(|mut n| {
+        let cut = |mut list: Vec<String>, colours: &Option<Vec<String>>| {
             let kept = colours.as_ref().unwrap_or(&vocab.colours);
-            n.retain(|c| kept.contains(c));
-            n
-        });
-        let regions = group_list(vocab.regions_of.as_deref(), name).map(|mut r| {
+            list.retain(|c| kept.contains(c));
+            list
+        };
+        let mut not_colours =
+            group_list(vocab.not_colours_of.as_deref(), name).map(|n| cut(n, &colours));
+        let mut regions = group_list(vocab.regions_of.as_deref(), name).map(|mut r| {
             r.retain(|x| keys.contains(x));
             r
         });
+        if pairs {
+            let Some((_, pair)) = vocab
+                .pairs_of
+                .iter()
+                .flatten()
+                .find(|(names, _)| names.contains(name))
+            else {
+                continue;
+            };
+            not_colours = Some(cut(pair.not_colours.clone(), &colours));
+            colours = Some(cut(pair.colours.clone(), &colours));
+            let mut r = pair.regions.clone();
+            r.retain(|x| keys.contains(x));
+            regions = Some(r);
+        }
         // Required only where the pick has a colour key to write.
         let has_colours = colours
             .as_ref()
@@ -805,6 +897,70 @@ fn pick_groups(vocab: &Vocabulary) -> Option<Vec<PickGroup>> {
         }
     }
     Some(groups)
+}
+
+/// A group's names, each followed by its selection map `selmap{tag}{g}` (optional unless
+/// the group must select on a colour): one alternative per group.
+fn named_selections(groups: &[PickGroup], tag: &str) -> Vec<String> {
+    groups
+        .iter()
+        .enumerate()
+        .map(|(g, group)| {
+            let sel = if group.colour_required || group.colour_key_required {
+                format!("\", \" selmap{tag}{g}")
+            } else {
+                format!("(\", \" selmap{tag}{g})?")
+            };
+            format!("({}) {sel}", alt(&group.names, true))
+        })
+        .collect()
+}
+
+/// The selection map of one group, `selmap{suffix}`, and its colour and region rules
+/// (`qcolour{suffix}`, `qncolour{suffix}`, `qregion{suffix}`) where its lists are its own;
+/// `all` are the shared colour and region rules (none: the map has none).
+fn group_rules(
+    w: &mut Writer,
+    suffix: &str,
+    group: &PickGroup,
+    (all_colours, all_regions): (Option<&str>, Option<&str>),
+    vocab: &Vocabulary,
+    not_from_end: bool,
+) {
+    let colours = match &group.colours {
+        None => all_colours.map(str::to_string),
+        Some(c) if c.is_empty() => None,
+        Some(c) => {
+            w.rule(&format!("qcolour{suffix}"), &alt(c, true));
+            Some(format!("qcolour{suffix}"))
+        }
+    };
+    let not_colours = match &group.not_colours {
+        None => colours.clone(),
+        Some(c) if c.is_empty() => None,
+        Some(c) if Some(c) == group.colours.as_ref() => colours.clone(),
+        Some(c) => {
+            w.rule(&format!("qncolour{suffix}"), &alt(c, true));
+            Some(format!("qncolour{suffix}"))
+        }
+    };
+    let regions = match &group.regions {
+        None => all_regions.map(str::to_string),
+        Some(r) if r.is_empty() => None,
+        Some(r) => {
+            w.rule(&format!("qregion{suffix}"), &alt(r, true));
+            Some(format!("qregion{suffix}"))
+        }
+    };
+    selection_rules(
+        w,
+        suffix,
+        (colours.as_deref(), not_colours.as_deref()),
+        regions.as_deref(),
+        vocab,
+        not_from_end,
+        (group.colour_required, group.colour_key_required),
+    );
 }
 
 /// Whether a selection may count from the start and from the end: `vocab.ordinals`
@@ -927,6 +1083,9 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         &format!("{comment}\"let \" var \" = \" pick \";\""),
     );
     // The registry's step functions that move back to the start, and the others.
+    // The groups of `move_between_the_two`'s names: with none, it is left out.
+    let pair_groups = pick_groups(vocab, true);
+    let pairs = pair_groups.as_ref().is_none_or(|g| !g.is_empty());
     let (back, other): (Vec<&str>, Vec<&str>) = STEP_FUNCTIONS
         .iter()
         .copied()
@@ -935,7 +1094,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     for (sfx, obj) in [("", "obj"), ("n", "objn")] {
         let steps: Vec<String> = STEP_FUNCTIONS
             .iter()
-            .filter_map(|n| call_rule(n, obj))
+            .filter_map(|n| call_rule(n, obj, pairs))
             .collect();
         w.rule(
             &format!("step{sfx}"),
@@ -948,7 +1107,10 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         }
         if vocab.return_required {
             let rules = |names: &[&str]| -> Vec<String> {
-                names.iter().filter_map(|n| call_rule(n, obj)).collect()
+                names
+                    .iter()
+                    .filter_map(|n| call_rule(n, obj, pairs))
+                    .collect()
             };
             if sfx.is_empty() {
                 w.rule("stmt_nr", &format!("letstmt | {comment}step_nr"));
@@ -975,21 +1137,13 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     );
     w.rule("var", &var);
     let get = q(&format!("{PICK_FUNCTION}("));
-    let groups = pick_groups(vocab);
+    let groups = pick_groups(vocab, false);
     match &groups {
         // One pick rule per group of names, each with its own colour and region lists.
         Some(groups) if !groups.is_empty() => {
             let mut picks = Vec::new();
-            for (g, group) in groups.iter().enumerate() {
-                let sel = if group.colour_required || group.colour_key_required {
-                    format!("\", \" selmap{g}")
-                } else {
-                    format!("(\", \" selmap{g})?")
-                };
-                w.rule(
-                    &format!("pick{g}"),
-                    &format!("{get} ({}) {sel} \")\"", alt(&group.names, true)),
-                );
+            for (g, names_sel) in named_selections(groups, "").iter().enumerate() {
+                w.rule(&format!("pick{g}"), &format!("{get} {names_sel} \")\""));
                 picks.push(format!("pick{g}"));
             }
             w.rule("pick", &picks.join(" | "));
@@ -1050,54 +1204,42 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     if !not_from_end.is_empty() {
         w.rule("qorderf", &alt(&not_from_end, true));
     }
-    // The shared selection map: `move_between_the_two` selects with it whatever the
-    // picks use.
     let all_colours = (!vocab.colours.is_empty()).then_some("qcolour");
     let all_regions = (!keys.is_empty()).then_some("qregion");
-    selection_rules(
-        &mut w,
-        "",
-        (all_colours, all_colours),
-        all_regions,
-        vocab,
-        !not_from_end.is_empty(),
-        (false, false),
-    );
-    for (g, group) in groups.iter().flatten().enumerate() {
-        let colours = match &group.colours {
-            None => all_colours.map(str::to_string),
-            Some(c) if c.is_empty() => None,
-            Some(c) => {
-                w.rule(&format!("qcolour{g}"), &alt(c, true));
-                Some(format!("qcolour{g}"))
+    let not_from_end = !not_from_end.is_empty();
+    // `move_between_the_two`'s name and selection: per pair group, or the shared map.
+    match &pair_groups {
+        Some(groups) => {
+            if !groups.is_empty() {
+                w.rule("namesel", &named_selections(groups, "p").join(" | "));
             }
-        };
-        let not_colours = match &group.not_colours {
-            None => colours.clone(),
-            Some(c) if c.is_empty() => None,
-            Some(c) if Some(c) == group.colours.as_ref() => colours.clone(),
-            Some(c) => {
-                w.rule(&format!("qncolour{g}"), &alt(c, true));
-                Some(format!("qncolour{g}"))
-            }
-        };
-        let regions = match &group.regions {
-            None => all_regions.map(str::to_string),
-            Some(r) if r.is_empty() => None,
-            Some(r) => {
-                w.rule(&format!("qregion{g}"), &alt(r, true));
-                Some(format!("qregion{g}"))
-            }
-        };
+        }
+        None => w.rule("namesel", "pname (\", \" selmap)?"),
+    }
+    // The shared selection map, where a pick or a pair selects with it.
+    let grouped = |g: &Option<Vec<PickGroup>>| g.as_ref().is_some_and(|g| !g.is_empty());
+    if !grouped(&groups) || pair_groups.is_none() {
         selection_rules(
             &mut w,
-            &g.to_string(),
-            (colours.as_deref(), not_colours.as_deref()),
-            regions.as_deref(),
+            "",
+            (all_colours, all_colours),
+            all_regions,
             vocab,
-            !not_from_end.is_empty(),
-            (group.colour_required, group.colour_key_required),
+            not_from_end,
+            (false, false),
         );
+    }
+    for (tag, gs) in [("", &groups), ("p", &pair_groups)] {
+        for (g, group) in gs.iter().flatten().enumerate() {
+            group_rules(
+                &mut w,
+                &format!("{tag}{g}"),
+                group,
+                (all_colours, all_regions),
+                vocab,
+                not_from_end,
+            );
+        }
     }
     let (positive, negative) = ordinal_signs(vocab);
     let ints: Vec<&str> = [(positive, "pint"), (negative, "nint")]
@@ -2035,6 +2177,77 @@ pub(crate) mod tests {
             &[
                 "get_obj(\"sofa\", #{colour: \"yellow\"})",
                 "get_obj(\"plant\", #{not_colour: \"green\"})",
+            ],
+            &[],
+        );
+    }
+
+    #[test]
+    fn with_map_colours_a_pair_selects_on_colours_two_objects_have_or_lack() {
+        let map = flat_a();
+        let mut v = Vocabulary::for_map(&map);
+        v.map_colours(&map);
+        let lark = answer_lark(&v);
+        assert_eq!(undefined_rules(&answer_grammar(&v)), Vec::<String>::new());
+        let answer = |step: &str| format!("objects: []\nplan:\n{step};");
+        // flat-a: tables black, white and two yellow; chairs three black, two red, a blue,
+        // a grey and a white; four green plants; a red and a black sofa; one fridge.
+        assert_offers(
+            &lark,
+            answer,
+            &[
+                "move_between_the_two(\"table\", #{colour: \"yellow\"})",
+                "move_between_the_two(\"table\", #{not_colour: \"yellow\"})",
+                "move_between_the_two(\"chair\", #{colour: \"red\"})",
+                "move_between_the_two(\"chair\", #{not_colour: \"blue\", region: \"dining room\"})",
+                "move_between_the_two(\"plant\")",
+                "move_between_the_two(\"couch\")",
+                // Picks keep every colour their objects have.
+                "move_to_object(get_obj(\"table\", #{colour: \"black\"}))",
+            ],
+            &[
+                // One black table, one blue chair, one red sofa: no pair.
+                "move_between_the_two(\"table\", #{colour: \"black\"})",
+                "move_between_the_two(\"chair\", #{colour: \"blue\"})",
+                "move_between_the_two(\"sofa\", #{colour: \"red\"})",
+                // Every plant is green: none lack it.
+                "move_between_the_two(\"plant\", #{not_colour: \"green\"})",
+                // One chair in the living room, one table in the kitchen, one plant
+                // in each room that has one.
+                "move_between_the_two(\"chair\", #{region: \"living room\"})",
+                "move_between_the_two(\"table\", #{region: \"kitchen\"})",
+                "move_between_the_two(\"plant\", #{region: \"living room\"})",
+                // One fridge, one tv.
+                "move_between_the_two(\"fridge\")",
+                "move_between_the_two(\"tv\")",
+            ],
+        );
+        // A re-ask's narrowed colours narrow a pair's too.
+        let mut barred = v.clone();
+        barred.colours_of = Some(vec![(vec!["chair".into()], vec!["black".into()])]);
+        assert_offers(
+            &answer_lark(&barred),
+            answer,
+            &["move_between_the_two(\"chair\", #{colour: \"black\"})"],
+            &["move_between_the_two(\"chair\", #{colour: \"red\"})"],
+        );
+        // A map where no name has two objects offers no pair at all.
+        let mut one_each = Vocabulary {
+            names: vec!["sofa".into(), "tv".into()],
+            colours: vec!["red".into()],
+            ..Vocabulary::default()
+        };
+        one_each.pairs_of = Some(Vec::new());
+        let g = answer_grammar(&one_each);
+        assert!(!g.contains("move_between_the_two"), "{g}");
+        assert_eq!(undefined_rules(&g), Vec::<String>::new());
+        // Off (the vocabulary of the map alone), any name and colour of the map goes.
+        assert_offers(
+            &answer_lark(&Vocabulary::for_map(&map)),
+            answer,
+            &[
+                "move_between_the_two(\"fridge\")",
+                "move_between_the_two(\"plant\", #{not_colour: \"green\"})",
             ],
             &[],
         );
