@@ -810,11 +810,9 @@ struct PickGroup {
 }
 
 /// The list of the group holding `name` in `groups` ([`Vocabulary::colours_of`],
-/// [`Vocabulary::regions_of`]): `None` when there are no groups or none holds it.
-pub(crate) fn group_list(
-    groups: Option<&[(Vec<String>, Vec<String>)]>,
-    name: &str,
-) -> Option<Vec<String>> {
+/// [`Vocabulary::regions_of`], [`Vocabulary::pairs_of`]): `None` when there are no
+/// groups or none holds it.
+pub(crate) fn group_list<T: Clone>(groups: Option<&[(Vec<String>, T)]>, name: &str) -> Option<T> {
     groups?
         .iter()
         .find(|(names, _)| names.iter().any(|n| n == name))
@@ -858,17 +856,12 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
             r
         });
         if pairs {
-            let Some((_, pair)) = vocab
-                .pairs_of
-                .iter()
-                .flatten()
-                .find(|(names, _)| names.contains(name))
-            else {
+            let Some(pair) = group_list(vocab.pairs_of.as_deref(), name) else {
                 continue;
             };
-            not_colours = Some(cut(pair.not_colours.clone(), &colours));
-            colours = Some(cut(pair.colours.clone(), &colours));
-            let mut r = pair.regions.clone();
+            not_colours = Some(cut(pair.not_colours, &colours));
+            colours = Some(cut(pair.colours, &colours));
+            let mut r = pair.regions;
             r.retain(|x| keys.contains(x));
             regions = Some(r);
         }
@@ -1082,10 +1075,10 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         "letstmt",
         &format!("{comment}\"let \" var \" = \" pick \";\""),
     );
-    // The registry's step functions that move back to the start, and the others.
     // The groups of `move_between_the_two`'s names: with none, it is left out.
     let pair_groups = pick_groups(vocab, true);
     let pairs = pair_groups.as_ref().is_none_or(|g| !g.is_empty());
+    // The registry's step functions that move back to the start, and the others.
     let (back, other): (Vec<&str>, Vec<&str>) = STEP_FUNCTIONS
         .iter()
         .copied()
@@ -1209,11 +1202,11 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     let not_from_end = !not_from_end.is_empty();
     // `move_between_the_two`'s name and selection: per pair group, or the shared map.
     match &pair_groups {
-        Some(groups) => {
-            if !groups.is_empty() {
-                w.rule("namesel", &named_selections(groups, "p").join(" | "));
-            }
+        Some(groups) if !groups.is_empty() => {
+            w.rule("namesel", &named_selections(groups, "p").join(" | "));
         }
+        // No name has a pair: `move_between_the_two` is left out, nothing uses it.
+        Some(_) => {}
         None => w.rule("namesel", "pname (\", \" selmap)?"),
     }
     // The shared selection map, where a pick or a pair selects with it.
