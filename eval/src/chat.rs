@@ -128,6 +128,7 @@ pub fn run_dialogue(
         trajectory: Some(robot.trajectory().clone()),
         reached: None,
         reasks: None,
+        first_answer_ok: None,
         turns: Some(turns),
     }
 }

@@ -17,7 +17,7 @@ pub mod report;
 pub mod score;
 pub mod suite;
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use map_core::{IvlMap, Robot, SimRobot, Trajectory};
@@ -26,7 +26,7 @@ use planner_dsl::{Limits, Plan};
 use agent::extract_tuples;
 use agent::tuples::same_tuples;
 use agent::{plan_instruction, Outcome, PlanContext, PlanOptions, PlanSource, Prompts, Tuple};
-use llm::LlmBackend;
+use llm::{Completion, CompletionRequest, LlmBackend, LlmError};
 
 use crate::baseline::vlmap_script;
 use crate::report::CaseResult;
@@ -85,6 +85,7 @@ pub fn run_extract(
                     reached: None,
                     turns: None,
                     reasks: None,
+                    first_answer_ok: None,
                 },
                 Err(e) => CaseResult {
                     id: c.id.clone(),
@@ -97,6 +98,7 @@ pub fn run_extract(
                     reached: None,
                     turns: None,
                     reasks: None,
+                    first_answer_ok: None,
                 },
             };
             on_case(&res);
@@ -111,6 +113,76 @@ struct Planned {
     plan: Result<Plan, String>,
     /// Re-asks the language layer made (`None` without a model).
     reasks: Option<u32>,
+    /// The language layer's first answer, where it was re-asked: the one its checks
+    /// judged before any re-ask.
+    first_answer: Option<String>,
+}
+
+impl Planned {
+    fn without_model(plan: Result<Plan, String>, tuples: Option<Vec<Tuple>>) -> Self {
+        Self {
+            tuples,
+            plan,
+            reasks: None,
+            first_answer: None,
+        }
+    }
+}
+
+/// A backend that keeps the first answer it passes on (the language layer's first
+/// answer to an instruction, before any re-ask).
+struct KeepFirst<'a> {
+    inner: &'a dyn LlmBackend,
+    first: Mutex<Option<String>>,
+}
+
+impl<'a> KeepFirst<'a> {
+    fn new(inner: &'a dyn LlmBackend) -> Self {
+        Self {
+            inner,
+            first: Mutex::new(None),
+        }
+    }
+
+    fn first(self) -> Option<String> {
+        self.first.into_inner().ok().flatten()
+    }
+}
+
+impl LlmBackend for KeepFirst<'_> {
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+
+    fn model(&self) -> &str {
+        self.inner.model()
+    }
+
+    fn complete(&self, req: &CompletionRequest) -> Result<Completion, LlmError> {
+        let c = self.inner.complete(req)?;
+        if let Ok(mut first) = self.first.lock() {
+            first.get_or_insert_with(|| c.text.clone());
+        }
+        Ok(c)
+    }
+}
+
+/// Whether `answer` (a model's answer in the v2 form: objects line, then plan), run as
+/// it stands from the task's start, reaches every subgoal: for a re-asked task, whether
+/// the checks re-asked a plan that was right.
+fn answer_reaches_all(task: &NavTask, answer: &str) -> bool {
+    let Ok(a) = agent::v2::answer::parse_answer(answer) else {
+        return false;
+    };
+    let Ok(plan) = Plan::compile(&a.plan.to_rhai()) else {
+        return false;
+    };
+    let mut robot = SimRobot::with_pose(task.map.clone(), task.start);
+    let out = planner_dsl::run(&plan, &task.map, &mut robot, &Limits::default());
+    out.error.is_none()
+        && reached(&task.map, &task.subgoals, &robot.trajectory().stops)
+            .iter()
+            .all(|b| *b)
 }
 
 fn plan_task(
@@ -123,70 +195,59 @@ fn plan_task(
 ) -> Planned {
     let need = || "this method needs an LLM backend".to_string();
     match method {
-        Method::Reference => Planned {
-            tuples: None,
-            plan: match &task.reference {
+        Method::Reference => Planned::without_model(
+            match &task.reference {
                 Some(src) => Plan::compile(src).map_err(|e| format!("reference plan: {e}")),
                 None => Err(format!("task {} has no \"reference\" plan", task.id)),
             },
-            reasks: None,
-        },
+            None,
+        ),
         Method::Vlmap => {
             let Some(b) = backend else {
-                return Planned {
-                    tuples: None,
-                    plan: Err(need()),
-                    reasks: None,
-                };
+                return Planned::without_model(Err(need()), None);
             };
             match extract_tuples(b, prompts, &task.instruction, options) {
-                Ok((tuples, _)) => Planned {
-                    plan: Plan::compile(&vlmap_script(&tuples)).map_err(|e| e.to_string()),
-                    tuples: Some(tuples),
-                    reasks: None,
-                },
-                Err(e) => Planned {
-                    tuples: None,
-                    plan: Err(e.to_string()),
-                    reasks: None,
-                },
+                Ok((tuples, _)) => Planned::without_model(
+                    Plan::compile(&vlmap_script(&tuples)).map_err(|e| e.to_string()),
+                    Some(tuples),
+                ),
+                Err(e) => Planned::without_model(Err(e.to_string()), None),
             }
         }
         Method::Ivlmap => {
             let Some(b) = backend else {
-                return Planned {
-                    tuples: None,
-                    plan: Err(need()),
-                    reasks: None,
-                };
+                return Planned::without_model(Err(need()), None);
             };
             let mut ctx = PlanContext::new(&task.map).with_robot(robot);
             ctx.options = options.clone();
-            match plan_instruction(b, prompts, &task.instruction, &ctx) {
-                Ok(Outcome::Plan(p)) => Planned {
-                    tuples: Some(p.tuples.clone()),
-                    plan: Ok(p.plan.clone()),
-                    reasks: Some(match p.source {
-                        PlanSource::Llm { repairs } => repairs,
-                    }),
-                },
+            let keep = KeepFirst::new(b);
+            let outcome = plan_instruction(&keep, prompts, &task.instruction, &ctx);
+            let first = keep.first();
+            match outcome {
+                Ok(Outcome::Plan(p)) => {
+                    let PlanSource::Llm { repairs } = p.source;
+                    Planned {
+                        tuples: Some(p.tuples.clone()),
+                        plan: Ok(p.plan.clone()),
+                        reasks: Some(repairs),
+                        first_answer: first.filter(|_| repairs > 0),
+                    }
+                }
                 // A question or refusal comes when the answer after the re-ask (if
                 // re-asks are on) still disagrees.
                 Ok(Outcome::Question(q)) => Planned {
                     tuples: None,
                     plan: Err(format!("asked a question instead of planning: {q}")),
                     reasks: Some(u32::from(options.reask)),
+                    first_answer: first,
                 },
                 Ok(Outcome::Refusal(r)) => Planned {
                     tuples: None,
                     plan: Err(format!("refused: {r}")),
                     reasks: Some(u32::from(options.reask)),
+                    first_answer: first,
                 },
-                Err(e) => Planned {
-                    tuples: None,
-                    plan: Err(e.to_string()),
-                    reasks: None,
-                },
+                Err(e) => Planned::without_model(Err(e.to_string()), None),
             }
         }
     }
@@ -252,6 +313,7 @@ pub fn run_task(
         reached: Some(reached),
         turns: None,
         reasks: planned.reasks,
+        first_answer_ok: planned.first_answer.map(|a| answer_reaches_all(task, &a)),
     }
 }
 
@@ -363,5 +425,39 @@ mod tests {
         );
         assert!(!r.ok && r.error.is_some());
         assert_eq!(r.trajectory.unwrap().error, r.error);
+    }
+
+    #[test]
+    fn a_first_answer_is_judged_by_running_it_as_it_was() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/suites");
+        let tasks = load_nav_suite(&dir.join("flat-a.nav.jsonl")).unwrap();
+        // fa1: the red sofa, the second yellow table from the west, the kitchen, the
+        // bathtub.
+        let t = &tasks[0];
+        let objects = "objects: [(sofa, None, red), (table, 2, yellow, west_to_east), (kitchen, None, None), (bathtub, None, None)]\nplan:\n";
+        let sofa = "move_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\n";
+        let rest = "move_to_object(\"kitchen\");\nmove_to_object(get_obj(\"bathtub\"));\n";
+        let table = |ordinal: i32| {
+            format!("move_to_object(get_obj(\"table\", #{{ordinal: {ordinal}, colour: \"yellow\", order: \"west_to_east\"}}));\n")
+        };
+        assert!(answer_reaches_all(
+            t,
+            &format!("{objects}{sofa}{}{rest}", table(2))
+        ));
+        // The first yellow table from the west is the wrong one.
+        assert!(!answer_reaches_all(
+            t,
+            &format!("{objects}{sofa}{}{rest}", table(1))
+        ));
+        // A plan that fails on the map (no third yellow table), and an answer that
+        // cannot be read, reach nothing.
+        assert!(!answer_reaches_all(
+            t,
+            &format!("{objects}{sofa}{}{rest}", table(3))
+        ));
+        assert!(!answer_reaches_all(
+            t,
+            "plan:\nmove_to_object(\"kitchen\");"
+        ));
     }
 }

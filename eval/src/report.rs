@@ -38,6 +38,11 @@ pub struct CaseResult {
     /// question or refusal comes after one); additive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reasks: Option<u32>,
+    /// Navigation with a model, where the first answer did not stand (a re-ask, a
+    /// question or a refusal followed): whether that first answer, run as it was, would
+    /// have reached every subgoal (the checks re-asked a right plan); additive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_answer_ok: Option<bool>,
 }
 
 /// The report's summary.
@@ -69,6 +74,10 @@ pub struct Summary {
     /// re-ask was made); additive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reask_rate: Option<f64>,
+    /// Of the cases whose first answer did not stand, how many first answers would have
+    /// reached every subgoal as they were (`first_answer_ok`); additive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reasked_first_ok: Option<usize>,
 }
 
 /// The report file of formats.md.
@@ -176,6 +185,12 @@ pub fn summarise(cases: &[CaseResult]) -> Summary {
         turn_accuracy: chat.map(|(ok, n)| ratio(ok, n)),
         dialogue_success: chat.map(|_| ratio(ok, cases.len())),
         reask_rate,
+        reasked_first_ok: cases.iter().any(|c| c.first_answer_ok.is_some()).then(|| {
+            cases
+                .iter()
+                .filter(|c| c.first_answer_ok == Some(true))
+                .count()
+        }),
     }
 }
 
@@ -257,6 +272,19 @@ pub fn summary_table(reports: &[Report]) -> String {
             ));
         }
     }
+    if reports.iter().any(|r| r.summary.reasked_first_ok.is_some()) {
+        rows.push((
+            "re-asked, first right".into(),
+            reports
+                .iter()
+                .map(|r| {
+                    r.summary
+                        .reasked_first_ok
+                        .map_or("-".into(), |n| n.to_string())
+                })
+                .collect(),
+        ));
+    }
     rows.push((
         "latency p50 ms".into(),
         reports
@@ -313,6 +341,7 @@ mod tests {
             reached,
             turns: None,
             reasks: None,
+            first_answer_ok: None,
         }
     }
 
@@ -325,8 +354,11 @@ mod tests {
         for (c, k) in cases.iter_mut().zip([0, 1, 0, 0]) {
             c.reasks = Some(k);
         }
+        assert_eq!(summarise(&cases).reasked_first_ok, None);
+        cases[1].first_answer_ok = Some(true);
         let s = summarise(&cases);
         assert_eq!(s.reask_rate, Some(0.25));
+        assert_eq!(s.reasked_first_ok, Some(1));
         let table = summary_table(&[Report {
             suite: "x.nav.jsonl".into(),
             backend: "llama".into(),
@@ -338,6 +370,12 @@ mod tests {
         }]);
         assert!(
             table.contains("re-asked") && table.contains("0.250"),
+            "{table}"
+        );
+        assert!(
+            table
+                .lines()
+                .any(|l| l.starts_with("re-asked, first right") && l.ends_with(" 1")),
             "{table}"
         );
     }

@@ -160,6 +160,28 @@ pub fn describe_label(map: &IvlMap, label: &str) -> String {
     format!("{n} {} ({})", noun(label, n), colour_list(&colours))
 }
 
+/// What the map holds of colour `c` (said as `word`), for questions: "I see 1 orange
+/// chair and 2 orange tables", or "I see nothing orange".
+fn describe_colour(map: &IvlMap, c: &str, word: &str) -> String {
+    let held: Vec<String> = map
+        .label_counts()
+        .into_iter()
+        .filter_map(|(label, _)| {
+            let n = map
+                .instances
+                .iter()
+                .filter(|i| i.label == label && same_colour(i.colour.as_deref(), c))
+                .count();
+            (n > 0).then(|| format!("{n} {word} {}", noun(&label, n)))
+        })
+        .collect();
+    match held.as_slice() {
+        [] => format!("I see nothing {word}"),
+        [one] => format!("I see {one}"),
+        [rest @ .., last] => format!("I see {} and {last}", rest.join(", ")),
+    }
+}
+
 /// The labels the map holds, then its regions.
 fn names_on_map(map: &IvlMap) -> Vec<String> {
     let mut v: Vec<String> = map.label_counts().into_iter().map(|(l, _)| l).collect();
@@ -464,8 +486,17 @@ fn check_words(
                         ),
                         None => format!("the person said \"{word}\", but no object in the plan has colour \"{c}\" (or not_colour \"{c}\")"),
                     };
-                    let mut f =
-                        Finding::new(FindingKind::Word, to_model, format!("what is {word}?"));
+                    // The question names the candidates: those of the object the colour
+                    // is said of, else what on the map has that colour ("what is
+                    // orange?" alone left the person to guess what was not understood).
+                    let to_user = match &of {
+                        Some((noun, label)) => format!(
+                            "which {noun} is {word}? there are {}",
+                            describe_label(map, label)
+                        ),
+                        None => format!("what is {word}? {}", describe_colour(map, &c, word)),
+                    };
+                    let mut f = Finding::new(FindingKind::Word, to_model, to_user);
                     if let Some((_, label)) = of {
                         f = f.barring(Bar::ColourDropped { label });
                     }
@@ -2573,7 +2604,31 @@ pub(crate) mod tests {
             f[0].to_model,
             "the person said \"black chair\", but no chair in the plan has colour \"black\": write colour: \"black\" in that chair's selection"
         );
-        assert_eq!(f[0].to_user, "what is black?");
+        assert_eq!(
+            f[0].to_user,
+            "which chair is black? there are 8 chairs (1 grey, 2 red, 3 black, 1 white, 1 blue)"
+        );
+    }
+
+    #[test]
+    fn a_dropped_colour_said_after_its_noun_is_asked_with_what_has_that_colour() {
+        // "the chair, the red one": no name follows the colour, so the question lists
+        // what on the map is red (flat-a: two red chairs and the red sofa).
+        let f = findings(
+            "go to the chair, the red one",
+            "objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));",
+        );
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert_eq!(
+            f[0].to_user,
+            "what is red? I see 2 red chairs and 1 red sofa"
+        );
+        let f = findings(
+            "go to the chair, the purple one",
+            "objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));",
+        );
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert_eq!(f[0].to_user, "what is purple? I see nothing purple");
     }
 
     #[test]
