@@ -128,6 +128,12 @@ pub struct PlanOptions {
     /// objects line, as the checks would. The answer is one text, the second request
     /// continuing the first (a prefix-caching backend evaluates only the new tokens).
     pub follow_objects: bool,
+    /// The first answer's picks of a name said only with a colour right before it ("the
+    /// yellow table closest to the counter") must select on one of the colours said of
+    /// it (`check::labels_always_coloured`): the re-ask's bar for a dropped colour,
+    /// given from the first answer on (default off until judged; `--said-colours-required`).
+    /// Outside a conversation only.
+    pub said_colours_required: bool,
 }
 
 impl Default for PlanOptions {
@@ -148,6 +154,7 @@ impl Default for PlanOptions {
             redraw_temperature: 0.7,
             reversed_draw: true,
             follow_objects: false,
+            said_colours_required: false,
         }
     }
 }

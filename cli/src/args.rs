@@ -301,6 +301,10 @@ pub(crate) struct ModelArgs {
     /// excluded). Off by default until judged on the untuned sets.
     #[arg(long)]
     pub(crate) follow_objects: bool,
+    /// From the first answer on, a pick of a name said only with a colour right before it
+    /// ("the yellow table closest to the counter") selects on a colour said of it.
+    #[arg(long)]
+    pub(crate) said_colours_required: bool,
 }
 
 impl ModelArgs {
@@ -341,6 +345,7 @@ impl ModelArgs {
             redraw_temperature: self.redraw_temperature,
             reversed_draw: !self.no_reversed_draw,
             follow_objects: self.follow_objects,
+            said_colours_required: self.said_colours_required,
             ..PlanOptions::default()
         }
     }

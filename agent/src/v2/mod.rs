@@ -344,6 +344,24 @@ fn reask_vocabulary(
     Some(v)
 }
 
+/// `vocab` with the re-ask's bar for a dropped colour ([`check::Bar::ColourDropped`]) on
+/// each name the instruction says only with a colour right before it
+/// ([`check::labels_always_coloured`]), for the first answer
+/// ([`crate::PlanOptions::said_colours_required`]): its picks select on a colour said of
+/// that name. `None` when no name is said so.
+fn said_colours_required(
+    vocab: &Vocabulary,
+    map: &map_core::IvlMap,
+    instruction: &str,
+    pose: Pose,
+) -> Option<Vocabulary> {
+    let bars: Vec<Finding> = check::labels_always_coloured(map, instruction, pose)
+        .into_iter()
+        .map(|label| Finding::bar_only(check::Bar::ColourDropped { label }))
+        .collect();
+    reask_vocabulary(vocab, map, instruction, &[], &bars, pose)
+}
+
 /// One answer drawn for an instruction (see [`plan_instruction`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Draw {
@@ -426,6 +444,11 @@ pub fn plan_instruction(
             );
             // Asked for by this instruction's words alone, as the checks read them.
             v.return_required = check::return_said(instruction);
+        }
+        if ctx.options.said_colours_required && ctx.references.is_empty() {
+            if let Some(r) = said_colours_required(&v, ctx.map, instruction, ctx.pose()) {
+                v = r;
+            }
         }
         v
     };
@@ -919,6 +942,46 @@ mod tests {
             &pick(r#""chair", #{colour: "red"}"#)
         )
         .is_ok());
+    }
+
+    #[test]
+    fn a_name_said_only_with_a_colour_is_picked_on_it_from_the_first_answer() {
+        // Held-out v2 (dev): "the yellow table that's closest to the counter" as
+        // `#{near: get_obj("counter")}`, the colour dropped beside another key.
+        let m = map();
+        let v = Vocabulary::for_map(&m);
+        let instruction = "go to the yellow table closest to the counter, then another chair";
+        let r = said_colours_required(&v, &m, instruction, m.start_pose).unwrap();
+        let lark = answer_lark(&r);
+        let pick = |sel: &str| {
+            format!("objects: [(table, None, yellow)]\nplan:\nmove_to_object(get_obj({sel}));")
+        };
+        grammar::tests::assert_offers(
+            &lark,
+            pick,
+            &[
+                r#""table", #{colour: "yellow", near: get_obj("counter")}"#,
+                r#""table", #{near: get_obj("counter"), colour: "yellow"}"#,
+                r#""chair""#,
+                r#""counter""#,
+            ],
+            &[
+                r#""table", #{near: get_obj("counter")}"#,
+                r#""table""#,
+                r#""table", #{colour: "white"}"#,
+                r#""table", #{not_colour: "white"}"#,
+            ],
+        );
+        // "another chair": said without a colour, so no name is barred.
+        assert_eq!(
+            said_colours_required(
+                &v,
+                &m,
+                "go to the red chair, then another chair",
+                m.start_pose
+            ),
+            None
+        );
     }
 
     #[test]
