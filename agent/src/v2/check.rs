@@ -89,12 +89,6 @@ impl Finding {
         }
     }
 
-    /// A finding that only carries `bar`, for a grammar built with that bar before any
-    /// answer (`PlanOptions::said_colours_required`).
-    pub(crate) fn bar_only(bar: Bar) -> Self {
-        Self::new(FindingKind::Word, "", "").barring(bar)
-    }
-
     fn barring(mut self, bar: Bar) -> Self {
         self.bar = Some(bar);
         self
@@ -391,12 +385,12 @@ pub(crate) fn colour_nouns(map: &IvlMap, instruction: &str, pose: Pose) -> Vec<(
 /// one" (a colour after its name).
 pub(crate) fn labels_always_coloured(map: &IvlMap, instruction: &str, pose: Pose) -> Vec<String> {
     let w = words(instruction);
+    // Each name a colour is said of, by where it begins.
     let coloured: Vec<(usize, String)> = (0..w.len())
         .filter(|&i| is_colour_word(&w[i]))
         .filter_map(|i| {
-            let (name, label) = noun_after(map, &w, i, pose)?;
-            let at = (i + 1..w.len()).find(|&j| name.split(' ').next() == Some(w[j].as_str()))?;
-            Some((at, label))
+            let at = noun_index_after(&w, i);
+            label_at(map, &w, at, pose).map(|(_, label, _)| (at, label))
         })
         .collect();
     let mut plain: Vec<String> = Vec::new();
@@ -406,19 +400,15 @@ pub(crate) fn labels_always_coloured(map: &IvlMap, instruction: &str, pose: Pose
             j += 1;
             continue;
         }
-        let two = w
-            .get(j + 1)
-            .and_then(|n| object_label(map, &format!("{} {n}", w[j]), pose));
-        let (label, len) = match two {
-            Some(l) => (Some(l), 2),
-            None => (object_label(map, &w[j], pose), 1),
-        };
-        if let Some(l) = label {
-            if !coloured.iter().any(|(at, c)| *at == j && *c == l) {
-                plain.push(l);
+        match label_at(map, &w, j, pose) {
+            Some((_, l, len)) => {
+                if !coloured.iter().any(|(at, c)| *at == j && *c == l) {
+                    plain.push(l);
+                }
+                j += len;
             }
+            None => j += 1,
         }
-        j += len;
     }
     let mut out: Vec<String> = coloured
         .into_iter()
@@ -435,6 +425,12 @@ pub(crate) fn labels_always_coloured(map: &IvlMap, instruction: &str, pose: Pose
 /// holds it as an object (not a region). Post-noun colours ("the sofa, the red one",
 /// "the chair painted red") have no name after them and are not judged here.
 fn noun_after(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<(String, String)> {
+    label_at(map, w, noun_index_after(w, i), pose).map(|(n, l, _)| (n, l))
+}
+
+/// Where the name a colour word at `i` is said of begins: the first word after it past
+/// other colour words and shades, at most three of them ([`noun_after`]).
+fn noun_index_after(w: &[String], i: usize) -> usize {
     let mut j = i + 1;
     while j < w.len()
         && j <= i + 3
@@ -442,15 +438,21 @@ fn noun_after(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<(Strin
     {
         j += 1;
     }
+    j
+}
+
+/// The map object (not a region) named by the words at `j`, two words ("coffee table")
+/// before one: the words, its label and how many words it takes.
+fn label_at(map: &IvlMap, w: &[String], j: usize, pose: Pose) -> Option<(String, String, usize)> {
     let one = w.get(j)?;
     let mut candidates = Vec::new();
     if let Some(two) = w.get(j + 1) {
-        candidates.push(format!("{one} {two}"));
+        candidates.push((format!("{one} {two}"), 2));
     }
-    candidates.push(one.clone());
+    candidates.push((one.clone(), 1));
     candidates
         .into_iter()
-        .find_map(|n| object_label(map, &n, pose).map(|l| (n, l)))
+        .find_map(|(n, len)| object_label(map, &n, pose).map(|l| (n, l, len)))
 }
 
 /// Whether `name` is the name of one of the map's regions (rooms).

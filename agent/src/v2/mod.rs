@@ -298,9 +298,22 @@ fn reask_vocabulary(
     findings: &[Finding],
     pose: Pose,
 ) -> Option<Vocabulary> {
+    let bars: Vec<&check::Bar> = findings.iter().filter_map(|f| f.bar.as_ref()).collect();
+    barred_vocabulary(vocab, map, instruction, known, &bars, pose)
+}
+
+/// [`reask_vocabulary`] for the bars themselves: `vocab` less the forms `bars` bar.
+fn barred_vocabulary(
+    vocab: &Vocabulary,
+    map: &map_core::IvlMap,
+    instruction: &str,
+    known: &[String],
+    bars: &[&check::Bar],
+    pose: Pose,
+) -> Option<Vocabulary> {
     let mut barred: Vec<&str> = Vec::new();
     let mut required: Vec<&str> = Vec::new();
-    for b in findings.iter().filter_map(|f| f.bar.as_ref()) {
+    for b in bars {
         match b {
             check::Bar::UnsaidColours { label } => barred.push(label),
             check::Bar::ColourDropped { label } => required.push(label),
@@ -355,11 +368,12 @@ fn said_colours_required(
     instruction: &str,
     pose: Pose,
 ) -> Option<Vocabulary> {
-    let bars: Vec<Finding> = check::labels_always_coloured(map, instruction, pose)
+    let bars: Vec<check::Bar> = check::labels_always_coloured(map, instruction, pose)
         .into_iter()
-        .map(|label| Finding::bar_only(check::Bar::ColourDropped { label }))
+        .map(|label| check::Bar::ColourDropped { label })
         .collect();
-    reask_vocabulary(vocab, map, instruction, &[], &bars, pose)
+    let bars: Vec<&check::Bar> = bars.iter().collect();
+    barred_vocabulary(vocab, map, instruction, &[], &bars, pose)
 }
 
 /// One answer drawn for an instruction (see [`plan_instruction`]).
