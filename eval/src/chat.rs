@@ -129,6 +129,7 @@ pub fn run_dialogue(
         reached: None,
         reasks: None,
         first_answer_ok: None,
+        sides: None,
         turns: Some(turns),
     }
 }

@@ -20,7 +20,7 @@ pub mod suite;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use map_core::{IvlMap, Robot, SimRobot, Trajectory};
+use map_core::{IvlMap, Robot, SimRobot, Stop, Trajectory};
 use planner_dsl::{Limits, Plan};
 
 use agent::extract_tuples;
@@ -30,7 +30,7 @@ use llm::{Completion, CompletionRequest, LlmBackend, LlmError};
 
 use crate::baseline::vlmap_script;
 use crate::report::CaseResult;
-use crate::score::reached;
+use crate::score::{reached, side_stops};
 use crate::suite::{ExtractCase, NavTask};
 
 pub use report::Report;
@@ -86,6 +86,7 @@ pub fn run_extract(
                     turns: None,
                     reasks: None,
                     first_answer_ok: None,
+                    sides: None,
                 },
                 Err(e) => CaseResult {
                     id: c.id.clone(),
@@ -99,6 +100,7 @@ pub fn run_extract(
                     turns: None,
                     reasks: None,
                     first_answer_ok: None,
+                    sides: None,
                 },
             };
             on_case(&res);
@@ -302,6 +304,9 @@ pub fn run_task(
         }
     };
     let reached = reached(map, &task.subgoals, &trajectory.stops);
+    let sides = reference_stops(task)
+        .map(|r| side_stops(map, &task.subgoals, &r, &trajectory.stops))
+        .filter(|s| !s.is_empty());
     CaseResult {
         id: task.id.clone(),
         ok: reached.iter().all(|b| *b),
@@ -314,7 +319,17 @@ pub fn run_task(
         turns: None,
         reasks: planned.reasks,
         first_answer_ok: planned.first_answer.map(|a| answer_reaches_all(task, &a)),
+        sides,
     }
+}
+
+/// The stops of the task's reference plan run from its start; `None` without one (or
+/// when it does not compile).
+fn reference_stops(task: &NavTask) -> Option<Vec<Stop>> {
+    let plan = Plan::compile(task.reference.as_deref()?).ok()?;
+    let mut robot = SimRobot::with_pose(task.map.clone(), task.start);
+    planner_dsl::run(&plan, &task.map, &mut robot, &Limits::default());
+    Some(robot.trajectory().stops.clone())
 }
 
 fn ms(t0: Instant) -> u64 {
@@ -425,6 +440,65 @@ mod tests {
         );
         assert!(!r.ok && r.error.is_some());
         assert_eq!(r.trajectory.unwrap().error, r.error);
+    }
+
+    #[test]
+    fn a_run_reports_the_side_stops_of_its_reference_and_which_it_kept() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/suites");
+        let tasks = load_nav_suite(&dir.join("flat-a.nav.jsonl")).unwrap();
+        let side = |src: &str| {
+            ["move_north", "move_south", "move_east", "move_west"]
+                .iter()
+                .chain(&["move_to_left", "move_to_right"])
+                .map(|f| src.matches(&format!("{f}(")).count())
+                .sum::<usize>()
+        };
+        let n: usize = tasks
+            .iter()
+            .map(|t| side(t.reference.as_deref().unwrap()))
+            .sum();
+        assert!(n > 0, "flat-a's references make a side move");
+        let run = |tasks: &[NavTask]| {
+            let cases = run_nav(
+                tasks,
+                Method::Reference,
+                None,
+                &Prompts::builtin(),
+                &PlanOptions::default(),
+                &mut |_| {},
+            );
+            Report::new("s".into(), "-".into(), "-".into(), "-".into(), None, cases)
+        };
+        let r = run(&tasks);
+        assert_eq!(r.summary.side_stops, Some(n));
+        assert_eq!(
+            r.summary.side_stops_kept,
+            Some(n),
+            "the reference keeps its sides"
+        );
+        // The same task planned with `move_to_object` at the side stop still reaches
+        // every subgoal (1.0 m of the object), and the side is reported not kept.
+        let t = tasks
+            .iter()
+            .find(|t| side(t.reference.as_deref().unwrap()) > 0)
+            .unwrap();
+        let mut plain = t.clone();
+        let src = t.reference.clone().unwrap();
+        let f = ["move_to_left", "move_to_right", "move_north"]
+            .into_iter()
+            .find(|f| src.contains(f))
+            .unwrap();
+        plain.reference = Some(src.replace(f, "move_to_object"));
+        let mut robot = SimRobot::with_pose(plain.map.clone(), plain.start);
+        let plan = Plan::compile(plain.reference.as_deref().unwrap()).unwrap();
+        planner_dsl::run(&plan, &plain.map, &mut robot, &Limits::default());
+        let stops = &robot.trajectory().stops;
+        assert!(reached(&t.map, &t.subgoals, stops).iter().all(|b| *b));
+        let sides = side_stops(&t.map, &t.subgoals, &reference_stops(t).unwrap(), stops);
+        assert_eq!(sides.len(), 1);
+        assert_eq!(sides[0].want, f);
+        assert_eq!(sides[0].got.as_deref(), Some("move_to_object"));
+        assert!(!sides[0].kept());
     }
 
     #[test]

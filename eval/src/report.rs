@@ -6,7 +6,7 @@ use std::path::Path;
 use map_core::Trajectory;
 use serde::{Deserialize, Serialize};
 
-use super::score::{nav_scores, ratio};
+use super::score::{nav_scores, ratio, SideStop};
 
 /// One evaluated case.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -43,6 +43,11 @@ pub struct CaseResult {
     /// have reached every subgoal (the checks re-asked a right plan); additive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub first_answer_ok: Option<bool>,
+    /// Navigation: the subgoals the task's reference plan reaches by a move to one side
+    /// of the object, with the call the run reached each by (see
+    /// [`SideStop`]); absent when there are none; additive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sides: Option<Vec<SideStop>>,
 }
 
 /// The report's summary.
@@ -78,6 +83,13 @@ pub struct Summary {
     /// reached every subgoal as they were (`first_answer_ok`); additive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reasked_first_ok: Option<usize>,
+    /// Navigation: subgoals whose reference stop is a move to one side of the object
+    /// (`sides`), over all cases; additive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub side_stops: Option<usize>,
+    /// Of those, how many the run reached with the same side function; additive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub side_stops_kept: Option<usize>,
 }
 
 /// The report file of formats.md.
@@ -172,6 +184,11 @@ pub fn summarise(cases: &[CaseResult]) -> Summary {
         .collect();
     let chat = (!turns.is_empty()).then(|| (turns.iter().filter(|t| t.ok()).count(), turns.len()));
     let reasks: Vec<u32> = cases.iter().filter_map(|c| c.reasks).collect();
+    let sides: Vec<&SideStop> = cases
+        .iter()
+        .filter_map(|c| c.sides.as_ref())
+        .flatten()
+        .collect();
     let reask_rate = (!reasks.is_empty())
         .then(|| ratio(reasks.iter().filter(|&&k| k > 0).count(), reasks.len()));
     Summary {
@@ -191,6 +208,8 @@ pub fn summarise(cases: &[CaseResult]) -> Summary {
                 .filter(|c| c.first_answer_ok == Some(true))
                 .count()
         }),
+        side_stops: (!sides.is_empty()).then_some(sides.len()),
+        side_stops_kept: (!sides.is_empty()).then(|| sides.iter().filter(|s| s.kept()).count()),
     }
 }
 
@@ -285,6 +304,20 @@ pub fn summary_table(reports: &[Report]) -> String {
                 .collect(),
         ));
     }
+    if reports.iter().any(|r| r.summary.side_stops.is_some()) {
+        rows.push((
+            "side stops kept".into(),
+            reports
+                .iter()
+                .map(
+                    |r| match (r.summary.side_stops_kept, r.summary.side_stops) {
+                        (Some(k), Some(n)) => format!("{k}/{n}"),
+                        _ => "-".into(),
+                    },
+                )
+                .collect(),
+        ));
+    }
     rows.push((
         "latency p50 ms".into(),
         reports
@@ -342,6 +375,7 @@ mod tests {
             turns: None,
             reasks: None,
             first_answer_ok: None,
+            sides: None,
         }
     }
 

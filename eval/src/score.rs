@@ -10,6 +10,7 @@
 //! credits later subgoals; T_k does not).
 
 use map_core::{IvlMap, Point, Stop};
+use planner_dsl::typed::Side;
 use serde::{Deserialize, Serialize};
 
 use super::suite::Subgoal;
@@ -37,6 +38,16 @@ pub fn satisfies(map: &IvlMap, goal: &Subgoal, p: Point) -> bool {
 /// Per subgoal, whether it was reached by the stops (in order, each stop at most once).
 #[must_use]
 pub fn reached(map: &IvlMap, subgoals: &[Subgoal], stops: &[Stop]) -> Vec<bool> {
+    reaching_stops(map, subgoals, stops)
+        .iter()
+        .map(Option::is_some)
+        .collect()
+}
+
+/// Per subgoal, the index in `stops` of the stop that reached it, as [`reached`]
+/// matches them (`None`: missed).
+#[must_use]
+pub fn reaching_stops(map: &IvlMap, subgoals: &[Subgoal], stops: &[Stop]) -> Vec<Option<usize>> {
     let mut next = 0usize;
     subgoals
         .iter()
@@ -45,14 +56,61 @@ pub fn reached(map: &IvlMap, subgoals: &[Subgoal], stops: &[Stop]) -> Vec<bool> 
                 .iter()
                 .enumerate()
                 .skip(next)
-                .find(|(_, s)| satisfies(map, g, Point::new(s.pose[0], s.pose[1])));
-            match hit {
-                Some((i, _)) => {
-                    next = i + 1;
-                    true
-                }
-                None => false,
+                .find(|(_, s)| satisfies(map, g, Point::new(s.pose[0], s.pose[1])))
+                .map(|(i, _)| i);
+            if let Some(i) = hit {
+                next = i + 1;
             }
+            hit
+        })
+        .collect()
+}
+
+/// A subgoal that the task's reference plan reaches by a move to one side of the
+/// object ("stop on the north side of the table": `move_north`), and the call of the
+/// run's stop that reached it. The 1.0 m radius credits any stop beside the object, so
+/// [`reached`] cannot tell whether the side was kept; this can.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SideStop {
+    /// The subgoal, counted from 1.
+    pub subgoal: usize,
+    /// The side function the reference plan stopped with, e.g. `move_north`.
+    pub want: String,
+    /// The library call of the run's stop that reached the subgoal; `None` when the
+    /// run missed it.
+    pub got: Option<String>,
+}
+
+impl SideStop {
+    /// Whether the run reached the subgoal with the same side function.
+    #[must_use]
+    pub fn kept(&self) -> bool {
+        self.got.as_deref() == Some(self.want.as_str())
+    }
+}
+
+/// The subgoals whose reference stop (`reference`: the stops of the task's reference
+/// plan) is a move to a side, with the call of the `run`'s stop that reached each.
+#[must_use]
+pub fn side_stops(
+    map: &IvlMap,
+    subgoals: &[Subgoal],
+    reference: &[Stop],
+    run: &[Stop],
+) -> Vec<SideStop> {
+    let want = reaching_stops(map, subgoals, reference);
+    let got = reaching_stops(map, subgoals, run);
+    want.iter()
+        .zip(&got)
+        .enumerate()
+        .filter_map(|(k, (w, g))| {
+            let call = &reference.get((*w)?)?.call;
+            Side::from_function(call).filter(|s| s.is_move())?;
+            Some(SideStop {
+                subgoal: k + 1,
+                want: call.clone(),
+                got: g.and_then(|i| run.get(i)).map(|s| s.call.clone()),
+            })
         })
         .collect()
 }
@@ -197,6 +255,50 @@ mod tests {
             vec![true, false, true]
         );
         assert_eq!(reached(&m, &three, &[]), vec![false, false, false]);
+        assert_eq!(
+            reaching_stops(&m, &three, &[stop(3.0, 2.0), stop(7.0, 2.0)]),
+            vec![Some(0), None, Some(1)]
+        );
+    }
+
+    #[test]
+    fn a_side_stop_is_kept_only_by_the_same_side_function() {
+        let m = map();
+        let goals = [
+            Subgoal::Object(1),
+            Subgoal::Object(2),
+            Subgoal::Region("kitchen".into()),
+        ];
+        let at = |x: f64, call: &str| Stop {
+            call: call.into(),
+            ..stop(x, 2.0)
+        };
+        // The reference stops north of table 1 (a side), at table 2 and in the kitchen.
+        let reference = [
+            at(2.0, "move_north"),
+            at(7.0, "move_to_object"),
+            at(6.0, "move_to_object"),
+        ];
+        let sides = |run: &[Stop]| side_stops(&m, &goals, &reference, run);
+        let want = |got: Option<&str>| {
+            vec![SideStop {
+                subgoal: 1,
+                want: "move_north".into(),
+                got: got.map(Into::into),
+            }]
+        };
+        let same = sides(&reference);
+        assert_eq!(same, want(Some("move_north")));
+        assert!(same[0].kept());
+        // Reached within 1.0 m by the plain move: reached, but the side was not kept.
+        let plain = sides(&[at(3.0, "move_to_object"), at(7.0, "move_to_object")]);
+        assert_eq!(plain, want(Some("move_to_object")));
+        assert!(!plain[0].kept());
+        assert!(!sides(&[at(3.0, "move_south")])[0].kept(), "another side");
+        assert_eq!(sides(&[]), want(None));
+        // A turn putting the object on one side is not a side stop.
+        let turn = [at(2.0, "with_object_on_left"), at(7.0, "move_to_object")];
+        assert!(side_stops(&m, &goals, &turn, &turn).is_empty());
     }
 
     #[test]

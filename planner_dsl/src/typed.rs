@@ -90,8 +90,17 @@ impl Side {
             .map_or("move_to_left", |(_, f)| f)
     }
 
-    fn from_function(f: &str) -> Option<Side> {
+    /// The side a library function names (`"move_north"` is [`Side::North`]); `None`
+    /// for any other function.
+    #[must_use]
+    pub fn from_function(f: &str) -> Option<Side> {
         Side::ALL.iter().find(|(_, n)| *n == f).map(|(s, _)| *s)
+    }
+
+    /// Whether the function moves the robot to that side (not a turn in place).
+    #[must_use]
+    pub fn is_move(self) -> bool {
+        !matches!(self, Side::OnLeft | Side::OnRight)
     }
 }
 

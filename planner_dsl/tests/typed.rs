@@ -260,3 +260,38 @@ proptest! {
         prop_assert_eq!(TypedPlan::parse(&p.to_rhai()).unwrap(), p);
     }
 }
+
+#[test]
+fn each_side_function_names_its_side_and_only_the_turns_do_not_move() {
+    let all = [
+        Side::Left,
+        Side::Right,
+        Side::North,
+        Side::South,
+        Side::East,
+        Side::West,
+        Side::OnLeft,
+        Side::OnRight,
+    ];
+    for side in all {
+        assert_eq!(Side::from_function(side.function()), Some(side));
+    }
+    assert_eq!(Side::from_function("move_to_object"), None);
+    assert_eq!(Side::from_function("move_north "), None);
+    let moves: Vec<&str> = all
+        .iter()
+        .filter(|s| s.is_move())
+        .map(|s| s.function())
+        .collect();
+    assert_eq!(
+        moves,
+        [
+            "move_to_left",
+            "move_to_right",
+            "move_north",
+            "move_south",
+            "move_east",
+            "move_west"
+        ]
+    );
+}
