@@ -179,12 +179,18 @@ fn answer_reaches_all(task: &NavTask, answer: &str) -> bool {
     let Ok(plan) = Plan::compile(&a.plan.to_rhai()) else {
         return false;
     };
+    let (stops, ran) = run_from_start(task, &plan);
+    ran && reached(&task.map, &task.subgoals, &stops)
+        .iter()
+        .all(|b| *b)
+}
+
+/// Runs `plan` on a simulated robot at the task's start: its stops, and whether it ran
+/// to the end without an error.
+fn run_from_start(task: &NavTask, plan: &Plan) -> (Vec<Stop>, bool) {
     let mut robot = SimRobot::with_pose(task.map.clone(), task.start);
-    let out = planner_dsl::run(&plan, &task.map, &mut robot, &Limits::default());
-    out.error.is_none()
-        && reached(&task.map, &task.subgoals, &robot.trajectory().stops)
-            .iter()
-            .all(|b| *b)
+    let out = planner_dsl::run(plan, &task.map, &mut robot, &Limits::default());
+    (robot.trajectory().stops.clone(), out.error.is_none())
 }
 
 fn plan_task(
@@ -327,9 +333,7 @@ pub fn run_task(
 /// when it does not compile).
 fn reference_stops(task: &NavTask) -> Option<Vec<Stop>> {
     let plan = Plan::compile(task.reference.as_deref()?).ok()?;
-    let mut robot = SimRobot::with_pose(task.map.clone(), task.start);
-    planner_dsl::run(&plan, &task.map, &mut robot, &Limits::default());
-    Some(robot.trajectory().stops.clone())
+    Some(run_from_start(task, &plan).0)
 }
 
 fn ms(t0: Instant) -> u64 {
@@ -447,11 +451,17 @@ mod tests {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/suites");
         let tasks = load_nav_suite(&dir.join("flat-a.nav.jsonl")).unwrap();
         let side = |src: &str| {
-            ["move_north", "move_south", "move_east", "move_west"]
-                .iter()
-                .chain(&["move_to_left", "move_to_right"])
-                .map(|f| src.matches(&format!("{f}(")).count())
-                .sum::<usize>()
+            [
+                "move_north",
+                "move_south",
+                "move_east",
+                "move_west",
+                "move_to_left",
+                "move_to_right",
+            ]
+            .iter()
+            .map(|f| src.matches(&format!("{f}(")).count())
+            .sum::<usize>()
         };
         let n: usize = tasks
             .iter()
@@ -482,19 +492,16 @@ mod tests {
             .iter()
             .find(|t| side(t.reference.as_deref().unwrap()) > 0)
             .unwrap();
-        let mut plain = t.clone();
         let src = t.reference.clone().unwrap();
         let f = ["move_to_left", "move_to_right", "move_north"]
             .into_iter()
             .find(|f| src.contains(f))
             .unwrap();
-        plain.reference = Some(src.replace(f, "move_to_object"));
-        let mut robot = SimRobot::with_pose(plain.map.clone(), plain.start);
-        let plan = Plan::compile(plain.reference.as_deref().unwrap()).unwrap();
-        planner_dsl::run(&plan, &plain.map, &mut robot, &Limits::default());
-        let stops = &robot.trajectory().stops;
-        assert!(reached(&t.map, &t.subgoals, stops).iter().all(|b| *b));
-        let sides = side_stops(&t.map, &t.subgoals, &reference_stops(t).unwrap(), stops);
+        let plan = Plan::compile(&src.replace(f, "move_to_object")).unwrap();
+        let (stops, ran) = run_from_start(t, &plan);
+        assert!(ran);
+        assert!(reached(&t.map, &t.subgoals, &stops).iter().all(|b| *b));
+        let sides = side_stops(&t.map, &t.subgoals, &reference_stops(t).unwrap(), &stops);
         assert_eq!(sides.len(), 1);
         assert_eq!(sides[0].want, f);
         assert_eq!(sides[0].got.as_deref(), Some("move_to_object"));
