@@ -344,6 +344,7 @@ fn ms(t0: Instant) -> u64 {
 mod tests {
     use super::*;
     use crate::suite::{load_nav_suite, Subgoal};
+    use planner_dsl::typed::{Step, TypedPlan};
     use std::path::Path;
 
     /// Every public navigation suite: each task's hand-written reference plan runs on
@@ -450,23 +451,15 @@ mod tests {
     fn a_run_reports_the_side_stops_of_its_reference_and_which_it_kept() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/suites");
         let tasks = load_nav_suite(&dir.join("flat-a.nav.jsonl")).unwrap();
-        let side = |src: &str| {
-            [
-                "move_north",
-                "move_south",
-                "move_east",
-                "move_west",
-                "move_to_left",
-                "move_to_right",
-            ]
-            .iter()
-            .map(|f| src.matches(&format!("{f}(")).count())
-            .sum::<usize>()
+        // The reference's typed steps; its side moves (`move_north`, `move_to_left`...).
+        let typed = |t: &NavTask| TypedPlan::parse(t.reference.as_deref().unwrap()).unwrap();
+        let side = |p: &TypedPlan| {
+            p.steps
+                .iter()
+                .filter(|s| matches!(s, Step::Side { side, .. } if side.is_move()))
+                .count()
         };
-        let n: usize = tasks
-            .iter()
-            .map(|t| side(t.reference.as_deref().unwrap()))
-            .sum();
+        let n: usize = tasks.iter().map(|t| side(&typed(t))).sum();
         assert!(n > 0, "flat-a's references make a side move");
         let run = |tasks: &[NavTask]| {
             let cases = run_nav(
@@ -488,16 +481,19 @@ mod tests {
         );
         // The same task planned with `move_to_object` at the side stop still reaches
         // every subgoal (1.0 m of the object), and the side is reported not kept.
-        let t = tasks
+        let t = tasks.iter().find(|t| side(&typed(t)) > 0).unwrap();
+        let mut p = typed(t);
+        let at = p
+            .steps
             .iter()
-            .find(|t| side(t.reference.as_deref().unwrap()) > 0)
+            .position(|s| matches!(s, Step::Side { side, .. } if side.is_move()))
             .unwrap();
-        let src = t.reference.clone().unwrap();
-        let f = ["move_to_left", "move_to_right", "move_north"]
-            .into_iter()
-            .find(|f| src.contains(f))
-            .unwrap();
-        let plan = Plan::compile(&src.replace(f, "move_to_object")).unwrap();
+        let Step::Side { side: was, object } = p.steps[at].clone() else {
+            unreachable!("found as a side step")
+        };
+        let f = was.function();
+        p.steps[at] = Step::GoTo(object);
+        let plan = Plan::compile(&p.to_rhai()).unwrap();
         let (stops, ran) = run_from_start(t, &plan);
         assert!(ran);
         assert!(reached(&t.map, &t.subgoals, &stops).iter().all(|b| *b));
