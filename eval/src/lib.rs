@@ -453,12 +453,8 @@ mod tests {
         let tasks = load_nav_suite(&dir.join("flat-a.nav.jsonl")).unwrap();
         // The reference's typed steps; its side moves (`move_north`, `move_to_left`...).
         let typed = |t: &NavTask| TypedPlan::parse(t.reference.as_deref().unwrap()).unwrap();
-        let side = |p: &TypedPlan| {
-            p.steps
-                .iter()
-                .filter(|s| matches!(s, Step::Side { side, .. } if side.is_move()))
-                .count()
-        };
+        let side_move = |s: &Step| matches!(s, Step::Side { side, .. } if side.is_move());
+        let side = |p: &TypedPlan| p.steps.iter().filter(|s| side_move(s)).count();
         let n: usize = tasks.iter().map(|t| side(&typed(t))).sum();
         assert!(n > 0, "flat-a's references make a side move");
         let run = |tasks: &[NavTask]| {
@@ -481,12 +477,13 @@ mod tests {
         );
         // The same task planned with `move_to_object` at the side stop still reaches
         // every subgoal (1.0 m of the object), and the side is reported not kept.
-        let t = tasks.iter().find(|t| side(&typed(t)) > 0).unwrap();
-        let mut p = typed(t);
-        let at = p
-            .steps
+        let (t, mut p, at) = tasks
             .iter()
-            .position(|s| matches!(s, Step::Side { side, .. } if side.is_move()))
+            .find_map(|t| {
+                let p = typed(t);
+                let at = p.steps.iter().position(side_move)?;
+                Some((t, p, at))
+            })
             .unwrap();
         let Step::Side { side: was, object } = p.steps[at].clone() else {
             unreachable!("found as a side step")
