@@ -95,6 +95,12 @@ pub struct Vocabulary {
     /// [`check::colour_said`](super::check) reads them (`said_tuple_colours` in
     /// `v2/mod.rs`). The plan's selections are not narrowed by this.
     pub tuple_colours: Option<Vec<String>>,
+    /// Names the plan may not stop at, face or bind with `let`, only pick another object
+    /// near (`near:`): a re-ask after an object the person named once, only to pick out
+    /// another, that the first answer also stopped at
+    /// ([`check::Bar::AnchorStop`](super::check::Bar::AnchorStop)). Empty: no such bar,
+    /// and the grammar is the same as without the field.
+    pub no_stops: Vec<String>,
 }
 
 /// The colours and regions a pair of objects of one name ("between the two yellow
@@ -204,6 +210,7 @@ impl Vocabulary {
             return_required: false,
             said_words: Vec::new(),
             tuple_colours: None,
+            no_stops: Vec::new(),
         }
     }
 
@@ -895,16 +902,29 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
 /// A group's names, each followed by its selection map `selmap{tag}{g}` (optional unless
 /// the group must select on a colour): one alternative per group.
 fn named_selections(groups: &[PickGroup], tag: &str) -> Vec<String> {
+    named_selections_but(groups, tag, &[])
+        .into_iter()
+        .map(|(_, s)| s)
+        .collect()
+}
+
+/// [`named_selections`] with the names of `but` left out, each with its group's index
+/// (a group left with no name is left out).
+fn named_selections_but(groups: &[PickGroup], tag: &str, but: &[String]) -> Vec<(usize, String)> {
     groups
         .iter()
         .enumerate()
-        .map(|(g, group)| {
+        .filter_map(|(g, group)| {
+            let names: Vec<&String> = group.names.iter().filter(|n| !but.contains(n)).collect();
+            if names.is_empty() {
+                return None;
+            }
             let sel = if group.colour_required || group.colour_key_required {
                 format!("\", \" selmap{tag}{g}")
             } else {
                 format!("(\", \" selmap{tag}{g})?")
             };
-            format!("({}) {sel}", alt(&group.names, true))
+            Some((g, format!("({}) {sel}", alt(&names, true))))
         })
         .collect()
 }
@@ -1071,9 +1091,19 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     } else {
         ""
     };
+    // With names barred from stops (`no_stops`), the steps' objects and the `let`s are
+    // of the `s...` rules, which leave them out; an anchor (`near:`) is any pick still.
+    // A bar that would leave no name to stop at bars nothing.
+    let barred =
+        vocab.names.iter().any(|n| !vocab.no_stops.contains(n)) && !vocab.no_stops.is_empty();
+    let (spick, sobj, sobjn) = if barred {
+        ("spick", "sobj", "sobjn")
+    } else {
+        ("pick", "obj", "objn")
+    };
     w.rule(
         "letstmt",
-        &format!("{comment}\"let \" var \" = \" pick \";\""),
+        &format!("{comment}\"let \" var \" = \" {spick} \";\""),
     );
     // The groups of `move_between_the_two`'s names: with none, it is left out.
     let pair_groups = pick_groups(vocab, true);
@@ -1084,7 +1114,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         .copied()
         .partition(|n| RETURN_FUNCTIONS.contains(n));
     // Each statement rule twice: with a variable on offer (`obj`) and without (`objn`).
-    for (sfx, obj) in [("", "obj"), ("n", "objn")] {
+    for (sfx, obj) in [("", sobj), ("n", sobjn)] {
         let steps: Vec<String> = STEP_FUNCTIONS
             .iter()
             .filter_map(|n| call_rule(n, obj, pairs))
@@ -1140,8 +1170,44 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 picks.push(format!("pick{g}"));
             }
             w.rule("pick", &picks.join(" | "));
+            if barred {
+                let spicks: Vec<String> = named_selections_but(groups, "", &vocab.no_stops)
+                    .into_iter()
+                    .map(|(g, names_sel)| {
+                        let all = &groups[g].names;
+                        if all.iter().any(|n| vocab.no_stops.contains(n)) {
+                            format!("{get} {names_sel} \")\"")
+                        } else {
+                            format!("pick{g}")
+                        }
+                    })
+                    .collect();
+                w.rule("spick", &spicks.join(" | "));
+            }
         }
-        _ => w.rule("pick", &format!("{get} pname (\", \" selmap)? \")\"")),
+        _ => {
+            w.rule("pick", &format!("{get} pname (\", \" selmap)? \")\""));
+            if barred {
+                w.rule("spick", &format!("{get} spname (\", \" selmap)? \")\""));
+            }
+        }
+    }
+    if barred {
+        let kept: Vec<&String> = vocab
+            .names
+            .iter()
+            .filter(|n| !vocab.no_stops.contains(n))
+            .collect();
+        w.rule("spname", &alt(&kept, true));
+        let sqname = if vocab.regions.is_empty() {
+            "spname".to_string()
+        } else {
+            format!("spname | {}", alt(&vocab.regions, true))
+        };
+        let inst = if vocab.ids.is_empty() { "" } else { " | inst" };
+        w.rule("sqname", &sqname);
+        w.rule("sobj", &format!("spick | sqname | var{inst}"));
+        w.rule("sobjn", &format!("spick | sqname{inst}"));
     }
     // An anchor (`near:`) is never a variable: it is written inside a pick, where the
     // grammar does not know whether a `let` came before.
@@ -1881,6 +1947,49 @@ pub(crate) mod tests {
                 .count()
         };
         assert_eq!(count(&g, " ::= "), count(&lark, ": "));
+    }
+
+    #[test]
+    fn a_name_barred_from_stops_may_still_pick_out_another_object() {
+        let plan = |steps: &str| {
+            format!("objects: [(chair, None, None), (sofa, None, None)]\nplan:\n{steps}")
+        };
+        for grouped in [false, true] {
+            let mut v = vocab();
+            if grouped {
+                v.colours_of = Some(vec![
+                    (vec!["chair".into()], vec!["black".into()]),
+                    (vec!["sofa".into(), "couch".into()], vec!["red".into()]),
+                ]);
+            }
+            let before = answer_lark(&v);
+            v.no_stops = vec!["sofa".into(), "couch".into()];
+            let lark = answer_lark(&v);
+            assert_ne!(lark, before);
+            assert_offers(
+                &lark,
+                plan,
+                &[
+                    "move_to_object(get_obj(\"chair\", #{near: get_obj(\"sofa\")}));",
+                    "move_to_object(get_obj(\"chair\"));\nmove_to_object(\"kitchen\");",
+                    "let c = get_obj(\"chair\", #{near: get_obj(\"couch\")});\nmove_to_object(c);\nface(c);",
+                ],
+                &[
+                    "move_to_object(get_obj(\"sofa\"));",
+                    "move_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"couch\"));",
+                    "move_to_object(\"sofa\");",
+                    "face(get_obj(\"sofa\"));",
+                    "move_to_left(get_obj(\"couch\"));",
+                    "let s = get_obj(\"sofa\");\nmove_to_object(s);",
+                    "move_in_between(get_obj(\"chair\"), get_obj(\"sofa\"));",
+                ],
+            );
+            let g = answer_grammar(&v);
+            assert!(undefined_rules(&g).is_empty(), "{:?}", undefined_rules(&g));
+            // A bar that would leave no name to stop at bars nothing.
+            v.no_stops = v.names.clone();
+            assert_eq!(answer_lark(&v), before);
+        }
     }
 
     #[test]

@@ -313,14 +313,23 @@ fn barred_vocabulary(
 ) -> Option<Vocabulary> {
     let mut barred: Vec<&str> = Vec::new();
     let mut required: Vec<&str> = Vec::new();
+    let mut no_stops: Vec<&str> = Vec::new();
     for b in bars {
         match b {
             check::Bar::UnsaidColours { label } => barred.push(label),
             check::Bar::ColourDropped { label } => required.push(label),
+            check::Bar::AnchorStop { label } => no_stops.push(label),
         }
     }
-    if barred.is_empty() && required.is_empty() {
+    if barred.is_empty() && required.is_empty() && no_stops.is_empty() {
         return None;
+    }
+    let mut v = vocab.clone();
+    for label in no_stops {
+        v.no_stops.extend(grammar::label_names(label.to_string()));
+    }
+    if barred.is_empty() && required.is_empty() {
+        return Some(v);
     }
     let said = check::colour_said(instruction, known);
     let said_of = check::colour_nouns(map, instruction, pose);
@@ -333,7 +342,6 @@ fn barred_vocabulary(
             .collect();
         !of.is_empty() && of.iter().all(|l| l.as_str() != label)
     };
-    let mut v = vocab.clone();
     v.colours_of = Some(name_groups(map, |label| {
         let mut list = grammar::label_names(label.to_string())
             .iter()
@@ -899,6 +907,41 @@ mod tests {
     fn first_findings(m: &map_core::IvlMap, instruction: &str, answer: &str) -> Vec<Finding> {
         let a = parse_answer(answer).unwrap();
         check::check_answer(m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[])
+    }
+
+    #[test]
+    fn a_reask_after_an_anchor_made_a_stop_bars_stopping_there_only() {
+        let m = map();
+        let v = Vocabulary::for_map(&m);
+        let instruction = "go to the plant by the tv";
+        let f = first_findings(
+            &m,
+            instruction,
+            "objects: [(plant, None, None), (tv, None, None)]\nplan:\nmove_to_object(get_obj(\"tv\"));\nmove_to_object(get_obj(\"plant\", #{near: get_obj(\"tv\")}));",
+        );
+        assert!(
+            f.iter()
+                .any(|x| x.bar == Some(check::Bar::AnchorStop { label: "tv".into() })),
+            "{f:?}"
+        );
+        let r = reask_vocabulary(&v, &m, instruction, &[], &f, m.start_pose).unwrap();
+        assert!(
+            r.no_stops.contains(&"tv".to_string())
+                && r.no_stops.contains(&"television".to_string()),
+            "{:?}",
+            r.no_stops
+        );
+        assert_eq!(r.colours_of, v.colours_of, "nothing else is narrowed");
+        let plan = |steps: &str| format!("objects: [(plant, None, None)]\nplan:\n{steps}");
+        grammar::tests::assert_offers(
+            &answer_lark(&r),
+            plan,
+            &["move_to_object(get_obj(\"plant\", #{near: get_obj(\"television\")}));"],
+            &[
+                "move_to_object(get_obj(\"tv\"));",
+                "move_to_object(get_obj(\"television\"));",
+            ],
+        );
     }
 
     #[test]
