@@ -1620,7 +1620,11 @@ fn picked<'a>(plan: &'a TypedPlan, o: &'a Object) -> Option<&'a Target> {
     }
 }
 
-/// An object said once, after the object it picks out, that the plan also stops at:
+/// How many words after the object it picks out an anchor may be named ("the bench
+/// closest to the gold statue": five).
+const ANCHOR_WORDS: usize = 6;
+
+/// An object said once, right after the object it picks out, that the plan also stops at:
 /// "the lamp by the white bed" planned as the white bed, then the lamp near it
 /// (held-out v3, dev: hh03; hi11's "the bench closest to the gold statue"). The plan
 /// picks the lamp near the bed (so the bed is the lamp's anchor) and stops at the bed
@@ -1679,6 +1683,15 @@ fn check_anchor_stops(
         };
         if at_anchor.len() != 1 || at_anchor[0] < first {
             continue;
+        }
+        // Said to pick it out: the last object named before the anchor is the picked one,
+        // at most six words before ("the bench closest to the gold statue"). Held-out v3
+        // (dev) hh12: the model picked "the white table nearest to you" near the red
+        // stools that the person named twelve words later as a stop of their own.
+        let k = at_anchor[0];
+        match mentions.iter().rfind(|(m, _)| *m < k) {
+            Some((m, l)) if *l == label && k - m <= ANCHOR_WORDS => {}
+            _ => continue,
         }
         out.push((
             anchor.clone(),
@@ -2375,10 +2388,13 @@ pub(crate) mod tests {
             "go to the plant closest to the television",
             bound
         )));
-        // Said before what it picks out, or said twice: a stop the person may want.
+        // Said before what it picks out, said twice, or said later as a stop of its own
+        // (the model made up the relation): a stop the person may want.
         for said in [
             "go to the tv, then the plant next to it",
             "go to the plant by the tv and then the tv",
+            "go to the plant nearest to you, and then stand right in front of the tv",
+            "go to the plant by the bed, then the tv",
         ] {
             let f = findings(said, both);
             assert!(!anchor(&f), "{said}: {f:?}");
