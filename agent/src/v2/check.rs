@@ -495,15 +495,12 @@ fn typed_label_at(map: &IvlMap, w: &[String], j: usize) -> Option<(String, Strin
         if is_region(map, &label) {
             continue;
         }
-        let mut names: Vec<String> = map_core::matcher::synonyms(&label)
-            .into_iter()
-            .map(str::to_string)
-            .collect();
-        names.push(label.clone());
-        for n in names.iter().filter(|n| !n.contains(' ')) {
+        for n in crate::v2::grammar::label_names(label.clone())
+            .iter()
+            .filter(|n| !n.contains(' '))
+        {
             let d = strsim::damerau_levenshtein(word, n);
-            let limit = if n.chars().count() < 6 { 1 } else { 2 };
-            if d > limit {
+            if d > typo_limit(n, 6) {
                 continue;
             }
             match &best {
@@ -994,9 +991,18 @@ pub(crate) fn colour_said<'a>(
 /// Whether one of the `said` words is `word` or a typo of it: one edit from it, two for
 /// a `word` of `long` letters or more.
 fn typed_as(said: &[String], word: &str, long: usize) -> bool {
-    let limit = if word.chars().count() < long { 1 } else { 2 };
+    let limit = typo_limit(word, long);
     said.iter()
         .any(|s| s == word || strsim::damerau_levenshtein(s, word) <= limit)
+}
+
+/// How many edits a typo of `word` may be: one, two for a word of `long` letters or more.
+fn typo_limit(word: &str, long: usize) -> usize {
+    if word.chars().count() < long {
+        1
+    } else {
+        2
+    }
 }
 
 /// Whether a region (a room) is named by `instruction`: every word of the region's name,
@@ -1671,9 +1677,12 @@ fn check_anchor_stops(
     }
     let mut out = Vec::new();
     for (label, anchor) in anchored {
+        let bar = Bar::AnchorStop {
+            label: anchor.clone(),
+        };
         if anchor == label
             || !stops.contains(&anchor)
-            || out.iter().any(|(a, _): &(String, Finding)| *a == anchor)
+            || out.iter().any(|f: &Finding| f.bar.as_ref() == Some(&bar))
         {
             continue;
         }
@@ -1693,17 +1702,16 @@ fn check_anchor_stops(
             Some((m, l)) if *l == label && k - m <= ANCHOR_WORDS => {}
             _ => continue,
         }
-        out.push((
-            anchor.clone(),
+        out.push(
             Finding::new(
                 FindingKind::Word,
                 format!("the person named the {anchor} once, after the {label}, to say which {label}: the plan goes to the {label} near the {anchor}, and must not also stop at the {anchor} itself"),
                 format!("shall I stop at the {anchor} too, or only at the {label} near it?"),
             )
-            .barring(Bar::AnchorStop { label: anchor }),
-        ));
+            .barring(bar),
+        );
     }
-    out.into_iter().map(|(_, f)| f).collect()
+    out
 }
 
 /// Everything found in `plan` and `tuples` for `instruction` on `map`. `visited` holds
