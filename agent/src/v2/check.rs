@@ -82,6 +82,13 @@ pub enum Bar {
         /// The map label.
         label: String,
     },
+    /// No selection counts from the end (a negative ordinal, the objects line's "last"):
+    /// every count from the end the person said is "furthest" before a side ("the shelf
+    /// furthest north"), the first in the order that starts there
+    /// (`check::ends_said_of_sides`). Measured without the bar on held-out v3 (dev): the
+    /// re-asks of "furthest east" wrote the last east-first (the westernmost) in each of
+    /// their draws.
+    CountFromStart,
 }
 
 impl Finding {
@@ -575,6 +582,10 @@ fn check_words(
     for (i, word) in w.iter().enumerate() {
         let prev = if i > 0 { w[i - 1].as_str() } else { "" };
         let next = w.get(i + 1).map_or("", String::as_str);
+        if word == "from" {
+            out.extend(counted_from_a_side(&w, i, &any_target));
+            continue;
+        }
         // Colours.
         if is_colour_word(word) && !name_words.contains(word) {
             if let Some(c) = normalise_colour(word) {
@@ -680,7 +691,11 @@ fn check_words(
                 };
                 if !any_target(&counted) {
                     let ordered = any_target(&|t| t.order == o || t.order == o.reversed());
-                    out.push(not_counted_from(&format!("{word} {next}"), o, ordered));
+                    let f = not_counted_from(&format!("{word} {next}"), o, ordered);
+                    out.push(match ends_said_of_sides(&w) {
+                        true => f.barring(Bar::CountFromStart),
+                        false => f,
+                    });
                 }
                 continue;
             }
@@ -818,6 +833,88 @@ fn check_words(
     out
 }
 
+/// How many words before "from the west" its count may be said ("the second to last
+/// red plant from the west": five).
+const FROM_WORDS: usize = 5;
+
+/// Whether `word` counts from the end ("last", "furthest", "penultimate"): a count
+/// "from the west" with it starts at the east.
+fn counts_from_the_end(word: &str) -> bool {
+    matches!(word, "last" | "furthest" | "farthest") || said_count(word) == Some(-2)
+}
+
+/// Whether some target of the plan passes a test.
+type AnyTarget<'a> = dyn Fn(&dyn Fn(&Target) -> bool) -> bool + 'a;
+
+/// A count said from a side (`w[at]` is "from"): "the second plant from the west" is
+/// ordinal 2 in `west_to_east`, and "the second to last plant from the west" ordinal 2
+/// in `east_to_west` (design.md). The count is said within [`FROM_WORDS`] words before
+/// "from", or after it where the words are "counting from the west, ...". A finding
+/// when no target is counted from that end (either sign: -k in the reverse is the same
+/// object). Held-out v3 (dev): "the second red chair counting from the west" was
+/// counted from the east and no check saw it.
+fn counted_from_a_side(w: &[String], at: usize, any_target: &AnyTarget<'_>) -> Vec<Finding> {
+    let (Some("the"), Some(side)) = (w.get(at + 1).map(String::as_str), w.get(at + 2)) else {
+        return Vec::new();
+    };
+    let Some(start) = ObjectOrder::starting_at(side) else {
+        return Vec::new();
+    };
+    let is_count = |x: &String| counts_from_the_end(x) || said_count(x).is_some();
+    let before = at.saturating_sub(FROM_WORDS)..at;
+    let counting = at > 0 && w[at - 1].starts_with("count");
+    let span = match w[before.clone()].iter().position(is_count) {
+        Some(p) => before.start + p..at + 3,
+        None if counting => match w
+            .iter()
+            .skip(at + 3)
+            .take(FROM_WORDS + 1)
+            .position(is_count)
+        {
+            Some(p) => at - 1..at + 4 + p,
+            None => return Vec::new(),
+        },
+        None => return Vec::new(),
+    };
+    let words = &w[span];
+    let reversed = words.iter().any(|x| counts_from_the_end(x));
+    let k = words
+        .iter()
+        .filter_map(|x| said_count(x))
+        .map(i64::abs)
+        .find(|&k| k > 1)
+        .unwrap_or(1);
+    let o = if reversed { start.reversed() } else { start };
+    if any_target(&|t| t.ordinal != 0 && from_end(t, o)) {
+        return Vec::new();
+    }
+    let said = words.join(" ");
+    let f = Finding::new(
+        FindingKind::Word,
+        format!(
+            "the person said \"{said}\": that is ordinal: {k} with order \"{}\", and no object in the plan is counted so",
+            o.name()
+        ),
+        format!("which one is the {said}?"),
+    );
+    vec![f]
+}
+
+/// Whether every count from the end that `w` says ([`counts_from_the_end`]: "last",
+/// "furthest", "penultimate") is "furthest" (or "farthest") right before a side ("the
+/// shelf furthest north"): a positive count in the order starting at that side says
+/// each ([`Bar::CountFromStart`]). "The farthest bin", "the last chair" and "the second
+/// to last shelf from the west" (`ordinal: -2, order: "west_to_east"`) count from an
+/// end.
+pub(crate) fn ends_said_of_sides(w: &[String]) -> bool {
+    w.iter().enumerate().all(|(j, x)| {
+        !counts_from_the_end(x)
+            || (matches!(x.as_str(), "furthest" | "farthest")
+                && w.get(j + 1)
+                    .is_some_and(|x| ObjectOrder::starting_at(x).is_some()))
+    })
+}
+
 /// The finding for a superlative (`said`: "biggest", "furthest west") that no target
 /// counts from the start of `o`; `ordered`: some target is counted in `o` or its reverse,
 /// from the other end.
@@ -826,7 +923,8 @@ fn not_counted_from(said: &str, o: ObjectOrder, ordered: bool) -> Finding {
         format!("the person said \"{said}\", but the plan counts order \"{}\" from the other end: for the {said} write ordinal: 1 with order \"{}\"", o.name(), o.name())
     } else {
         format!(
-            "the person said \"{said}\", but no object in the plan is counted in the order \"{}\"",
+            "the person said \"{said}\", but no object in the plan is counted in the order \"{}\": for the {said} write ordinal: 1 with order \"{}\"",
+            o.name(),
             o.name()
         )
     };
@@ -2416,6 +2514,92 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn a_count_from_a_side_is_counted_from_that_side() {
+        // Held-out v3 (dev): "the second red chair counting from the west" counted from
+        // the east passed every check.
+        for (instruction, select, says) in [
+            (
+                "go to the second red chair counting from the west",
+                "#{ordinal: 2, colour: \"red\", order: \"east_to_west\"}",
+                "said \"second red chair counting from the west\": that is ordinal: 2 with order \"west_to_east\"",
+            ),
+            (
+                "counting from the left, go to the third chair",
+                "#{ordinal: 3, order: \"right_to_left\"}",
+                "said \"counting from the left go to the third\": that is ordinal: 3 with order \"left_to_right\"",
+            ),
+            (
+                "go to the second to last chair from the north",
+                "#{ordinal: 2, order: \"north_to_south\"}",
+                "that is ordinal: 2 with order \"south_to_north\"",
+            ),
+            (
+                "the last chair from the east",
+                "#{ordinal: 1, order: \"east_to_west\"}",
+                "said \"last chair from the east\": that is ordinal: 1 with order \"west_to_east\"",
+            ),
+            // The count must be on some target: a side with no count at all.
+            (
+                "the second chair from the south",
+                "#{ordinal: 2}",
+                "that is ordinal: 2 with order \"south_to_north\"",
+            ),
+        ] {
+            assert_word_finding(instruction, "chair", select, says);
+        }
+        for (instruction, select) in [
+            (
+                "go to the second red chair counting from the west",
+                "#{ordinal: 2, colour: \"red\", order: \"west_to_east\"}",
+            ),
+            (
+                "go to the second to last chair from the north",
+                "#{ordinal: 2, order: \"south_to_north\"}",
+            ),
+            (
+                "the last chair from the east",
+                "#{ordinal: 1, order: \"west_to_east\"}",
+            ),
+            // No count near: "from the west" says nothing to count.
+            ("go to the chair, coming from the west", "#{ordinal: 1}"),
+            ("walk over from the kitchen to the chair", "#{ordinal: 1}"),
+        ] {
+            let f = findings_for_pick(instruction, "chair", select);
+            assert!(
+                !f.iter()
+                    .any(|x| x.to_model.contains("no object in the plan is counted so")),
+                "{instruction} {select}: {f:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_count_from_the_end_may_be_said_of_a_side_only() {
+        for (instruction, of_sides) in [
+            ("the shelf furthest north, then the red chair", true),
+            (
+                "the chair furthest to the left, the desk farthest south",
+                false,
+            ),
+            ("the second to last shelf from the west", false),
+            (
+                "the desk furthest south, the last chair from the left",
+                false,
+            ),
+            ("the farthest bin, then the shelf furthest north", false),
+            ("the last chair, then the shelf furthest north", false),
+            ("the table furthest from you", false),
+            ("the last shelf, the one from the kitchen", false),
+        ] {
+            assert_eq!(
+                ends_said_of_sides(&words(instruction)),
+                of_sides,
+                "{instruction}"
+            );
+        }
+    }
+
+    #[test]
     fn penultimate_counts_from_the_end() {
         // Qwen 1.5B on people.nav: "the penultimate plant from the west" as the first.
         let f = findings(
@@ -2435,6 +2619,17 @@ pub(crate) mod tests {
             "objects: [(plant, 2, None, west_to_east)]\nplan:\nmove_to_object(get_obj(\"plant\", #{ordinal: -2, order: \"west_to_east\"}));",
         );
         assert!(f.is_empty(), "{f:?}");
+        // The second from the west is not the penultimate from the west.
+        let f = findings(
+            "then the penultimate plant from the west",
+            "objects: [(plant, 2, None, west_to_east)]\nplan:\nmove_to_object(get_obj(\"plant\", #{ordinal: 2, order: \"west_to_east\"}));",
+        );
+        assert!(
+            f.iter().any(|x| x.to_model.contains(
+                "said \"penultimate plant from the west\": that is ordinal: 2 with order \"east_to_west\""
+            )),
+            "{f:?}"
+        );
         // The second nearest is not the penultimate.
         let f = findings(
             "the penultimate plant",

@@ -314,17 +314,26 @@ fn barred_vocabulary(
     let mut barred: Vec<&str> = Vec::new();
     let mut required: Vec<&str> = Vec::new();
     let mut no_stops: Vec<&str> = Vec::new();
+    let mut from_start = false;
     for b in bars {
         match b {
             check::Bar::UnsaidColours { label } => barred.push(label),
             check::Bar::ColourDropped { label } => required.push(label),
             check::Bar::AnchorStop { label } => no_stops.push(label),
+            check::Bar::CountFromStart => from_start = true,
         }
     }
-    if barred.is_empty() && required.is_empty() && no_stops.is_empty() {
+    if barred.is_empty() && required.is_empty() && no_stops.is_empty() && !from_start {
         return None;
     }
     let mut v = vocab.clone();
+    if from_start {
+        let ks = v
+            .ordinals
+            .take()
+            .unwrap_or_else(|| (1..=99).flat_map(|k| [k, -k]).collect());
+        v.ordinals = Some(ks.into_iter().filter(|&k| k > 0).collect());
+    }
     for label in no_stops {
         v.no_stops.extend(grammar::label_names(label.to_string()));
     }
@@ -941,6 +950,69 @@ mod tests {
                 "move_to_object(get_obj(\"tv\"));",
                 "move_to_object(get_obj(\"television\"));",
             ],
+        );
+    }
+
+    #[test]
+    fn a_reask_after_a_side_counted_from_the_end_counts_from_the_start_only() {
+        let m = map();
+        let mut v = Vocabulary::for_map(&m);
+        let instruction = "go to the chair furthest north";
+        narrow_to_words(&mut v, instruction, &PlanContext::new(&m));
+        // Held-out v3 (dev): "the stool furthest east" as the last east-first; with
+        // that off the grammar, "the shelf furthest north" as the farthest shelf.
+        let f = first_findings(
+            &m,
+            instruction,
+            "objects: [(chair, last, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: -1, order: \"near_to_far\"}));",
+        );
+        assert!(
+            f.iter().any(|x| x.bar == Some(check::Bar::CountFromStart)
+                && x.to_model
+                    .contains("write ordinal: 1 with order \"north_to_south\"")),
+            "{f:?}"
+        );
+        let r = reask_vocabulary(&v, &m, instruction, &[], &f, m.start_pose).unwrap();
+        assert_eq!(r.colours_of, v.colours_of, "nothing else is narrowed");
+        let answer = |a: &str| {
+            format!("{a}\nplan:\nmove_to_object(get_obj(\"chair\", #{{ordinal: 1, order: \"north_to_south\"}}));")
+        };
+        grammar::tests::assert_offers(
+            &answer_lark(&r),
+            answer,
+            &["objects: [(chair, 1, None, north_to_south)]"],
+            &[
+                "objects: [(chair, last, None)]",
+                "objects: [(chair, last, None, south_to_north)]",
+            ],
+        );
+        let plan = |sel: &str| {
+            format!("objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));")
+        };
+        grammar::tests::assert_offers(
+            &answer_lark(&r),
+            plan,
+            &[
+                "ordinal: 1, order: \"north_to_south\"",
+                "order: \"north_to_south\"",
+            ],
+            &[
+                "ordinal: -1",
+                "ordinal: -1, order: \"near_to_far\"",
+                "ordinal: -1, order: \"south_to_north\"",
+            ],
+        );
+        // "The farthest table" needs a count from the end: no bar.
+        let instruction = "go to the farthest table, then the chair furthest north";
+        let f = first_findings(
+            &m,
+            instruction,
+            "objects: [(table, last, None), (chair, last, None)]\nplan:\nmove_to_object(get_obj(\"table\", #{ordinal: -1}));\nmove_to_object(get_obj(\"chair\", #{ordinal: -1}));",
+        );
+        assert!(
+            f.iter().any(|x| x.to_model.contains("furthest north"))
+                && f.iter().all(|x| x.bar.is_none()),
+            "{f:?}"
         );
     }
 
