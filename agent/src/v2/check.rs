@@ -889,15 +889,14 @@ fn counted_from_a_side(w: &[String], at: usize, any_target: &AnyTarget<'_>) -> V
         return Vec::new();
     }
     let said = words.join(" ");
-    let f = Finding::new(
+    vec![Finding::new(
         FindingKind::Word,
         format!(
             "the person said \"{said}\": that is ordinal: {k} with order \"{}\", and no object in the plan is counted so",
             o.name()
         ),
         format!("which one is the {said}?"),
-    );
-    vec![f]
+    )]
 }
 
 /// Whether every count from the end that `w` says ([`counts_from_the_end`]: "last",

@@ -472,10 +472,12 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
     let n = w.pattern("[1-9] [0-9]?", "[1-9][0-9]?");
     // "last" is a count from the end: not where the selections count none (a re-ask's
     // bar, [`super::check::Bar::CountFromStart`]).
-    match ordinal_signs(vocab).1 {
-        true => w.rule("tordinal", &format!("\"None\" | \"last\" | {n}")),
-        false => w.rule("tordinal", &format!("\"None\" | {n}")),
-    }
+    let last = if ordinal_signs(vocab).1 {
+        " | \"last\""
+    } else {
+        ""
+    };
+    w.rule("tordinal", &format!("\"None\"{last} | {n}"));
     let tcolours: Vec<&String> = match &vocab.tuple_colours {
         Some(offered) => colours.iter().filter(|c| offered.contains(c)).collect(),
         None => colours.iter().collect(),

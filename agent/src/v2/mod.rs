@@ -328,11 +328,11 @@ fn barred_vocabulary(
     }
     let mut v = vocab.clone();
     if from_start {
-        let ks = v
-            .ordinals
-            .take()
-            .unwrap_or_else(|| (1..=99).flat_map(|k| [k, -k]).collect());
-        v.ordinals = Some(ks.into_iter().filter(|&k| k > 0).collect());
+        // `None` or empty offers any count (`Vocabulary::ordinals`): then every positive.
+        v.ordinals = Some(match v.ordinals.take() {
+            Some(ks) if !ks.is_empty() => ks.into_iter().filter(|&k| k > 0).collect(),
+            _ => (1..=99).collect(),
+        });
     }
     for label in no_stops {
         v.no_stops.extend(grammar::label_names(label.to_string()));
