@@ -902,12 +902,13 @@ fn counted_from_a_side(w: &[String], at: usize, any_target: &AnyTarget<'_>) -> V
 /// Whether every count from the end that `w` says ([`counts_from_the_end`]: "last",
 /// "furthest", "penultimate") is "furthest" (or "farthest") right before a side ("the
 /// shelf furthest north"): a positive count in the order starting at that side says
-/// each ([`Bar::CountFromStart`]). "The farthest bin", "the last chair" and "the second
-/// to last shelf from the west" (`ordinal: -2, order: "west_to_east"`) count from an
-/// end.
+/// each ([`Bar::CountFromStart`]). "The farthest bin", "the last chair", "the most
+/// distant chair" ([`speaks_of_the_far_end`], as [`far_end_said`] reads it) and "the
+/// second to last shelf from the west" (`ordinal: -2, order: "west_to_east"`) count from
+/// an end.
 pub(crate) fn ends_said_of_sides(w: &[String]) -> bool {
     w.iter().enumerate().all(|(j, x)| {
-        !counts_from_the_end(x)
+        !(counts_from_the_end(x) || speaks_of_the_far_end(x))
             || (matches!(x.as_str(), "furthest" | "farthest")
                 && w.get(j + 1)
                     .is_some_and(|x| ObjectOrder::starting_at(x).is_some()))
@@ -1515,7 +1516,17 @@ pub(crate) fn direction_said(instruction: &str) -> bool {
 /// second to last", "the penultimate": design.md counts them in `far_to_near`), which the
 /// order `far_to_near` needs.
 pub(crate) fn far_end_said(instruction: &str) -> bool {
-    starts_a_word(instruction, &["far", "furth", "distan", "last", "penult"])
+    starts_a_word(instruction, FAR_END_STEMS)
+}
+
+/// The starts of words that speak of the far end ([`far_end_said`]).
+const FAR_END_STEMS: &[&str] = &["far", "furth", "distan", "last", "penult"];
+
+/// Whether `word` starts as a word that speaks of the far end does ("most distant",
+/// "far away", "lastly"): the one reading [`far_end_said`] and [`ends_said_of_sides`]
+/// share, so that no count from the end the first sees is missed by the second.
+fn speaks_of_the_far_end(word: &str) -> bool {
+    FAR_END_STEMS.iter().any(|s| word.starts_with(s))
 }
 
 /// Targets counted in `far_to_near` when no word of the instruction speaks of the far
@@ -2589,6 +2600,13 @@ pub(crate) mod tests {
             ("the last chair, then the shelf furthest north", false),
             ("the table furthest from you", false),
             ("the last shelf, the one from the kitchen", false),
+            // Each word far_end_said reads as the far end keeps the bar off.
+            (
+                "the most distant chair, then the shelf furthest north",
+                false,
+            ),
+            ("the chair far away, then the shelf furthest north", false),
+            ("the shelf furthest north, then the furthermost bin", false),
         ] {
             assert_eq!(
                 ends_said_of_sides(&words(instruction)),
