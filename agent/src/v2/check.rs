@@ -728,15 +728,35 @@ fn check_words(
             }
             continue;
         }
-        // Directional superlatives ("westernmost").
+        // Directional superlatives ("westernmost"): the first from that side, on the
+        // object they are said of when its name follows and the plan picks it ("the
+        // westernmost red shelf"). Held-out v4 (dev): "the westernmost shelf" as
+        // `ordinal: -1, order: "west_to_east"` (the easternmost), and "treadmill number
+        // 2, then the westernmost bike" as the second bike from the west, passed a check
+        // that asked only for the order. "The second westernmost" is the second.
         if let Ok((Some(1), Some(order))) = parse_ordinal_with_order(word) {
             if let Ok(o) = ObjectOrder::parse(&order) {
-                if !any_target(&|t| t.order == o || t.order == o.reversed()) {
-                    out.push(Finding::new(
-                        FindingKind::Word,
-                        format!("the person said \"{word}\", but no object in the plan is counted in the order \"{order}\""),
-                        format!("which one is the {word}?"),
-                    ));
+                let of_noun = count_noun(map, &w, i, pose).map(|(_, l)| l).filter(|l| {
+                    any_target(&|t| label_of(map, &t.name, pose).as_deref() == Some(l))
+                });
+                let on_noun = |t: &Target| {
+                    of_noun
+                        .as_ref()
+                        .is_none_or(|l| label_of(map, &t.name, pose).as_deref() == Some(l))
+                };
+                let ordered = any_target(&|t| t.order == o || t.order == o.reversed());
+                match said_count(prev).filter(|&k| k > 1) {
+                    Some(k) if !any_target(&|t| on_noun(t) && counts_from(t, o, k)) => {
+                        out.push(Finding::new(
+                            FindingKind::Word,
+                            format!("the person said \"{prev} {word}\", but no object in the plan is counted so: that is ordinal: {k} with order \"{order}\""),
+                            format!("which one is the {prev} {word}?"),
+                        ));
+                    }
+                    None if !any_target(&|t| on_noun(t) && counts_from(t, o, 1)) => {
+                        out.push(not_counted_from(word, o, ordered));
+                    }
+                    _ => {}
                 }
             }
             continue;
@@ -794,8 +814,21 @@ fn check_words(
                     k.to_string()
                 };
                 // The object the count is said of ("the second chair"), when its name
-                // follows: the count must be on a target of that object.
-                let noun = count_noun(map, &w, at, pose);
+                // follows, or, after "number", comes right before ("chair number 3,
+                // then the plant": held-out v4 (dev) hk05 read the plant as counted):
+                // the count must be on a target of that object.
+                let before = match prev {
+                    "number" | "no" | "#" => noun_before(map, &w, i - 1, pose),
+                    _ => None,
+                };
+                let said_of = |noun: &str| match before {
+                    Some(_) => format!("{noun} {prev} {word}"),
+                    None => format!("{prev} {word} {noun}"),
+                };
+                let noun = match &before {
+                    Some(l) => Some((l.clone(), l.clone())),
+                    None => count_noun(map, &w, at, pose),
+                };
                 if !any_target(&counts) {
                     let of = noun
                         .as_ref()
@@ -819,7 +852,7 @@ fn check_words(
                     if any_target(&of_label) && !any_target(&|t| of_label(t) && counts(t)) {
                         out.push(Finding::new(
                             FindingKind::Word,
-                            format!("the person said \"{prev} {word} {noun}\", but no {label} in the plan has ordinal {wanted}: the count belongs to the {label}"),
+                            format!("the person said \"{}\", but no {label} in the plan has ordinal {wanted}: the count belongs to the {label}", said_of(&noun)),
                             format!(
                                 "which {noun} is the {word}? there are {}",
                                 describe_label(map, &label)
@@ -915,6 +948,18 @@ pub(crate) fn ends_said_of_sides(w: &[String]) -> bool {
     })
 }
 
+/// Whether the person counts from an end only as "furthest" + a side, and says one
+/// ("the shelf furthest north, then the red chair", [`ends_said_of_sides`]): each such
+/// count is a positive one in the order starting at that side, and none counts from the
+/// robot, so a first answer is offered what a re-ask after a "furthest" + side finding
+/// is ([`Bar::CountFromStart`]), and no `far_to_near`.
+pub(crate) fn only_sides_counted_from_the_end(instruction: &str) -> bool {
+    let w = words(instruction);
+    ends_said_of_sides(&w)
+        && w.iter()
+            .any(|x| matches!(x.as_str(), "furthest" | "farthest"))
+}
+
 /// The finding for a superlative (`said`: "biggest", "furthest west") that no target
 /// counts from the start of `o`; `ordered`: some target is counted in `o` or its reverse,
 /// from the other end.
@@ -933,6 +978,13 @@ fn not_counted_from(said: &str, o: ObjectOrder, ordered: bool) -> Finding {
         to_model,
         format!("which one is the {said}?"),
     )
+}
+
+/// Whether `t` is the `k`-th from the start of `order` ("the westernmost": 1 in
+/// `west_to_east`, -1 in `east_to_west`; an unspecified ordinal is the first).
+fn counts_from(t: &Target, order: ObjectOrder, k: i64) -> bool {
+    let ordinal = if t.ordinal == 0 { 1 } else { t.ordinal };
+    (t.order == order && ordinal == k) || (t.order == order.reversed() && ordinal == -k)
 }
 
 /// Whether `t` counts from the start of `order` ("the biggest": the first
@@ -1467,6 +1519,23 @@ pub(crate) fn plan_returns(plan: &TypedPlan) -> bool {
         .any(|s| matches!(s, Step::ToStart | Step::MoveTo(_)))
 }
 
+/// Whether `instruction` says "between" (design.md: "between the two yellow tables",
+/// "between the red sofa and the black one" are stops between two objects).
+pub(crate) fn between_said(instruction: &str) -> bool {
+    words(instruction)
+        .iter()
+        .any(|w| matches!(w.as_str(), "between" | "inbetween"))
+}
+
+/// Whether `plan` stops between two objects (`move_in_between`, `move_between_the_two`).
+/// Held-out v3 (dev) hg11: "stop between the bench and the white shelf" planned as the
+/// bench nearest the shelf passed every check.
+fn plan_stops_between(plan: &TypedPlan) -> bool {
+    plan.steps
+        .iter()
+        .any(|s| matches!(s, Step::Between(..) | Step::BetweenTwo(_)))
+}
+
 /// Whether a word of `instruction` starts with one of `stems`.
 fn starts_a_word(instruction: &str, stems: &[&str]) -> bool {
     words(instruction)
@@ -1784,6 +1853,20 @@ fn check_anchor_stops(
         }
     }
     let mut out = Vec::new();
+    // An object picked near another of its kind that the person named once (held-out
+    // v4, dev, hj14: "the stool nearest to you" as the stool nearest the first stool).
+    for (label, _) in anchored.iter().filter(|(l, a)| l == a) {
+        if said_at(label).len() < 2 {
+            let f = Finding::new(
+                FindingKind::Word,
+                format!("the plan picks a {label} near another {label}, but the person named the {label} once: it is not its own anchor (with no near, distances are from the robot)"),
+                format!("which {label} do you mean? there are {}", describe_label(map, label)),
+            );
+            if !out.contains(&f) {
+                out.push(f);
+            }
+        }
+    }
     for (label, anchor) in anchored {
         let bar = Bar::AnchorStop {
             label: anchor.clone(),
@@ -1872,6 +1955,13 @@ pub fn check_answer_after(
             FindingKind::Word,
             to_model,
             "should I come back to where I started, and when?",
+        ));
+    }
+    if between_said(instruction) && !plan_stops_between(plan) {
+        out.push(Finding::new(
+            FindingKind::Word,
+            "the person said \"between\", but the plan stops between nothing: write move_in_between(a, b) for between two objects, or move_between_the_two(name, ...) for between the two of one kind",
+            "between what shall I stop?",
         ));
     }
     let known = known_colours(map, refs, earlier);
@@ -2479,6 +2569,82 @@ pub(crate) mod tests {
             Some(("tabel".into(), "table".into()))
         );
         assert_eq!(typed_label_at(&m, &w, 1), None, "second");
+    }
+
+    #[test]
+    fn a_count_after_number_is_said_of_the_name_before_it() {
+        // Held-out v4 (dev) hk05: "chair number 3, then the plant" was read as the
+        // plant's count, and a right plan became a question.
+        let answer = |chair: &str, plant: &str| {
+            format!(
+                "objects: [(chair, 2, None), (plant, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"{chair}));\nmove_to_object(get_obj(\"plant\"{plant}));"
+            )
+        };
+        let said = "go to chair number 2, then the plant";
+        let ok = findings(said, &answer(", #{ordinal: 2}", ""));
+        assert!(ok.is_empty(), "{ok:?}");
+        let f = findings(said, &answer("", ", #{ordinal: 2}"));
+        assert!(
+            f.iter().any(|x| x.kind == FindingKind::Word
+                && x.to_model.contains(
+                    "\"chair number 2\", but no chair in the plan has ordinal 2: the count belongs to the chair"
+                )),
+            "{f:?}"
+        );
+        // With no name before "number", the name after it: "number 2 chair".
+        let f = findings(
+            "go to number 2 chair, then the plant",
+            &answer("", ", #{ordinal: 2}"),
+        );
+        assert!(
+            f.iter()
+                .any(|x| x.to_model.contains("the count belongs to the chair")),
+            "{f:?}"
+        );
+    }
+
+    #[test]
+    fn a_stop_between_said_is_a_stop_between() {
+        let said = "go to the chair, then stop between the table and the white sofa";
+        let near = "objects: [(chair, None, None), (table, None, None), (sofa, None, white)]\nplan:\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"table\", #{near: get_obj(\"sofa\", #{colour: \"white\"})}));";
+        let f = findings(said, near);
+        assert!(
+            f.iter().any(|x| x.kind == FindingKind::Word
+                && x.to_model.contains("the plan stops between nothing")),
+            "{f:?}"
+        );
+        let between = "objects: [(chair, None, None), (table, None, None), (sofa, None, white)]\nplan:\nmove_to_object(get_obj(\"chair\"));\nmove_in_between(get_obj(\"table\"), get_obj(\"sofa\", #{colour: \"white\"}));";
+        let f = findings(said, between);
+        assert!(
+            f.iter().all(|x| !x.to_model.contains("between nothing")),
+            "{f:?}"
+        );
+        assert!(!between_said("go to the chair, then the table"));
+        assert!(between_said("stop in between the two sofas"));
+    }
+
+    #[test]
+    fn an_object_named_once_is_not_its_own_anchor() {
+        let pick = |select: &str| {
+            format!("objects: [(chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", {select}));")
+        };
+        let said = "go to the chair nearest to you";
+        let f = findings(said, &pick("#{near: get_obj(\"chair\", #{ordinal: 1})}"));
+        assert!(
+            f.iter().any(|x| x.kind == FindingKind::Word
+                && x.to_model.contains("picks a chair near another chair")),
+            "{f:?}"
+        );
+        assert!(findings(said, &pick("#{ordinal: 1}")).is_empty());
+        // Named twice: the person may mean one chair near another.
+        let f = findings(
+            "go to the chair nearest to the red chair",
+            "objects: [(chair, None, None), (chair, None, red)]\nplan:\nmove_to_object(get_obj(\"chair\", #{near: get_obj(\"chair\", #{colour: \"red\"})}));",
+        );
+        assert!(
+            f.iter().all(|x| !x.to_model.contains("near another chair")),
+            "{f:?}"
+        );
     }
 
     #[test]
@@ -3328,5 +3494,51 @@ pub(crate) mod tests {
             "objects: [(chair, None, None), (sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"sofa\"));",
         );
         assert_eq!(bad.len(), 2, "{bad:?}");
+    }
+
+    #[test]
+    fn a_directional_superlative_is_the_first_from_its_side_on_its_noun() {
+        let said = "go to the westernmost chair";
+        // The first west-first or the last east-first; an order alone is the first.
+        for ok in [
+            "#{ordinal: 1, order: \"west_to_east\"}",
+            "#{order: \"west_to_east\"}",
+            "#{ordinal: -1, order: \"east_to_west\"}",
+        ] {
+            let f = findings_for_pick(said, "chair", ok);
+            assert!(f.is_empty(), "{ok}: {f:?}");
+        }
+        // Held-out v4 (dev): the easternmost, and the second from the west.
+        for (bad, says) in [
+            ("#{ordinal: -1, order: \"west_to_east\"}", "counts order \"west_to_east\" from the other end: for the westernmost write ordinal: 1 with order \"west_to_east\""),
+            ("#{ordinal: 2, order: \"west_to_east\"}", "for the westernmost write ordinal: 1"),
+            ("#{ordinal: 1, order: \"east_to_west\"}", "for the westernmost write ordinal: 1"),
+        ] {
+            assert_word_finding(said, "chair", bad, says);
+        }
+        // Another object's first from the west does not stand for the chair's.
+        let f = findings(
+            "go to the westernmost chair, then the table",
+            "objects: [(chair, None, None), (table, 1, None, west_to_east)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, order: \"west_to_east\"}));\nmove_to_object(get_obj(\"table\", #{ordinal: 1, order: \"west_to_east\"}));",
+        );
+        assert!(
+            f.iter().any(|x| x.to_model.contains("for the westernmost")),
+            "{f:?}"
+        );
+        // "The second westernmost" is the second from the west.
+        let said = "go to the second westernmost chair";
+        for ok in [
+            "#{ordinal: 2, order: \"west_to_east\"}",
+            "#{ordinal: -2, order: \"east_to_west\"}",
+        ] {
+            let f = findings_for_pick(said, "chair", ok);
+            assert!(f.is_empty(), "{ok}: {f:?}");
+        }
+        assert_word_finding(
+            said,
+            "chair",
+            "#{ordinal: 1, order: \"west_to_east\"}",
+            "that is ordinal: 2 with order \"west_to_east\"",
+        );
     }
 }

@@ -227,10 +227,11 @@ fn settle(findings: &[Finding]) -> Outcome {
 /// its objects' colours.
 fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>) {
     let counts = check::counts_said(instruction);
+    let from_start = check::only_sides_counted_from_the_end(instruction);
     v.ordinals = Some(
         (1..=20)
             .flat_map(|k| [k, -k])
-            .filter(|&k| check::ordinal_said(&counts, k))
+            .filter(|&k| check::ordinal_said(&counts, k) && (k > 0 || !from_start))
             .collect(),
     );
     if ctx.references.is_empty() {
@@ -249,7 +250,8 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
 fn narrow_orders(v: &mut Vocabulary, instruction: &str) {
     v.no_directions = !check::direction_said(instruction);
     v.no_sizes = !check::size_said(instruction);
-    v.no_far_end = !check::far_end_said(instruction);
+    v.no_far_end =
+        !check::far_end_said(instruction) || check::only_sides_counted_from_the_end(instruction);
 }
 
 /// The objects line's colour words ([`grammar::tuple_colour_words`]) said by
@@ -1151,6 +1153,28 @@ mod tests {
                 r#""chair""#,
             ],
         );
+    }
+
+    #[test]
+    fn furthest_and_a_side_is_offered_as_a_count_from_that_side() {
+        // Every count from the end said is "furthest" + a side: positive counts only,
+        // and no far_to_near (the re-ask's bar, given before the first answer).
+        let v = narrowed("go to the shelf furthest north, then the second chair", &[]);
+        assert_eq!(v.ordinals, Some(vec![1, 2]));
+        assert!(v.no_far_end);
+        // Any other count from the end keeps -1 and far_to_near on offer.
+        for instruction in [
+            "the farthest bin, then the shelf furthest north",
+            "the most distant chair, then the shelf furthest north",
+            "the second to last shelf from the west",
+            "go to the last chair",
+        ] {
+            let v = narrowed(instruction, &[]);
+            assert!(v.ordinals.as_ref().unwrap().contains(&-1), "{instruction}");
+            assert!(!v.no_far_end, "{instruction}");
+        }
+        // Nothing said of an end: as before (the first and the last are always said).
+        assert_eq!(narrowed("the red chair", &[]).ordinals, Some(vec![1, -1]));
     }
 
     #[test]
