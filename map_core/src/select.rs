@@ -414,8 +414,10 @@ impl IvlMap {
                 k: sel.ordinal.max(1),
             });
         }
+        let mut region = None;
         if let Some(name) = given(sel.region.as_deref()) {
             let r = self.find_region_with(matcher, name)?;
+            region = Some(r.name.clone());
             let all = same.len();
             same.retain(|i| r.polygon.contains(i.centroid));
             if same.is_empty() {
@@ -473,6 +475,7 @@ impl IvlMap {
                 name: label,
                 colour: given(sel.colour.as_deref()).unwrap_or_default().to_string(),
                 available,
+                region,
             });
         }
         if let Some(id) = sel.other_than {
@@ -750,6 +753,11 @@ mod tests {
             )
             .unwrap_err();
         assert!(matches!(e, QueryError::NoSuchColour { .. }), "{e}");
+        // The message says the room: the kitchen's one table is not all the tables.
+        assert_eq!(
+            e.to_string(),
+            "there is no yellow table in the kitchen; the table in the kitchen is: 1 grey"
+        );
     }
 
     #[test]
