@@ -145,6 +145,27 @@ fn label_of_typed(map: &IvlMap, name: &str, pose: Pose) -> Option<String> {
     }
 }
 
+/// Whether a target picks an object of `label`.
+fn picks<'a>(map: &'a IvlMap, pose: Pose, label: &'a str) -> impl Fn(&Target) -> bool + 'a {
+    move |t| label_of(map, &t.name, pose).as_deref() == Some(label)
+}
+
+/// Whether a target is on the object a word is said of: any target when the words name
+/// no object the plan picks (`of` is None), else a target of that object.
+fn on_said<'a>(map: &'a IvlMap, pose: Pose, of: Option<&'a str>) -> impl Fn(&Target) -> bool + 'a {
+    move |t| of.is_none_or(|l| picks(map, pose, l)(t))
+}
+
+/// The said object's label, kept only where some target of the plan picks it.
+fn said_and_picked(
+    map: &IvlMap,
+    pose: Pose,
+    label: Option<String>,
+    any_target: &AnyTarget<'_>,
+) -> Option<String> {
+    label.filter(|l| any_target(&picks(map, pose, l)))
+}
+
 /// Every target of the plan with the label it means.
 fn targets(plan: &TypedPlan) -> Vec<&Target> {
     plan.steps.iter().flat_map(Step::targets).collect()
@@ -631,8 +652,7 @@ fn check_words(
                 // The colour on the object it is said of: "the chair next to the black
                 // table" is a black table, not a black chair.
                 if let Some((noun, label)) = noun_after(map, &w, i, pose) {
-                    let of_label =
-                        |t: &Target| label_of(map, &t.name, pose).as_deref() == Some(&label);
+                    let of_label = picks(map, pose, &label);
                     // Excluded only where a word before says so ("not the red chair",
                     // "other than the red chair"): "the yellow table furthest from you"
                     // answered `#{ordinal: -1, not_colour: "yellow"}` (held-out v2's hf11,
@@ -663,7 +683,7 @@ fn check_words(
                                     describe_label(map, &label)
                                 ),
                             )
-                            .barring(Bar::ColourDropped { label }),
+                            .barring(Bar::ColourDropped { label: label.clone() }),
                         );
                     }
                 }
@@ -680,15 +700,10 @@ fn check_words(
                 // On the object it is said of, when that object's name comes right before
                 // ("the desk furthest west"; held-out v2: another target's order let the
                 // desk's wrong end pass).
-                let of_noun = noun_before(map, &w, i, pose).filter(|l| {
-                    any_target(&|t| label_of(map, &t.name, pose).as_deref() == Some(l))
-                });
-                let counted = |t: &Target| {
-                    from_end(t, o)
-                        && of_noun
-                            .as_ref()
-                            .is_none_or(|l| label_of(map, &t.name, pose).as_deref() == Some(l))
-                };
+                let of_noun =
+                    said_and_picked(map, pose, noun_before(map, &w, i, pose), &any_target);
+                let on_noun = on_said(map, pose, of_noun.as_deref());
+                let counted = |t: &Target| from_end(t, o) && on_noun(t);
                 if !any_target(&counted) {
                     let ordered = any_target(&|t| t.order == o || t.order == o.reversed());
                     let f = not_counted_from(&format!("{word} {next}"), o, ordered);
@@ -736,14 +751,9 @@ fn check_words(
         // that asked only for the order. "The second westernmost" is the second.
         if let Ok((Some(1), Some(order))) = parse_ordinal_with_order(word) {
             if let Ok(o) = ObjectOrder::parse(&order) {
-                let of_noun = count_noun(map, &w, i, pose).map(|(_, l)| l).filter(|l| {
-                    any_target(&|t| label_of(map, &t.name, pose).as_deref() == Some(l))
-                });
-                let on_noun = |t: &Target| {
-                    of_noun
-                        .as_ref()
-                        .is_none_or(|l| label_of(map, &t.name, pose).as_deref() == Some(l))
-                };
+                let of_noun = count_noun(map, &w, i, pose).map(|(_, l)| l);
+                let of_noun = said_and_picked(map, pose, of_noun, &any_target);
+                let on_noun = on_said(map, pose, of_noun.as_deref());
                 let ordered = any_target(&|t| t.order == o || t.order == o.reversed());
                 match said_count(prev).filter(|&k| k > 1) {
                     Some(k) if !any_target(&|t| on_noun(t) && counts_from(t, o, k)) => {
@@ -847,8 +857,7 @@ fn check_words(
                         to_user,
                     ));
                 } else if let Some((noun, label)) = noun {
-                    let of_label =
-                        |t: &Target| label_of(map, &t.name, pose).as_deref() == Some(&label);
+                    let of_label = picks(map, pose, &label);
                     if any_target(&of_label) && !any_target(&|t| of_label(t) && counts(t)) {
                         out.push(Finding::new(
                             FindingKind::Word,
