@@ -97,6 +97,11 @@ pub struct PlanOptions {
     /// With `said_only`, outside a conversation: a pick of each object may select only
     /// on the colours the person said that some object of that name has on this map.
     pub said_colours: bool,
+    /// With `said_only`, outside a conversation: a pick (and a pair of
+    /// `move_between_the_two`) may exclude a colour (`not_colour`) only where the person
+    /// excludes something, and only a colour they said (default on; `--any-not-colours`
+    /// turns it off).
+    pub said_exclusions: bool,
     /// The objects line's colours are the person's (default on; `--any-tuple-colours`
     /// turns it off).
     pub said_tuple_colours: bool,
@@ -148,6 +153,7 @@ impl Default for PlanOptions {
             llguidance: true,
             said_only: true,
             said_colours: false,
+            said_exclusions: true,
             said_tuple_colours: true,
             map_colours: true,
             redraws: 1,

@@ -269,6 +269,11 @@ pub(crate) struct ModelArgs {
     /// has on the map (outside a conversation; for comparison).
     #[arg(long, conflicts_with = "open_selections")]
     pub(crate) said_colours: bool,
+    /// Let a pick exclude any colour its objects tell apart by (`not_colour`), not only
+    /// a colour the person said where a word excludes something (the default before
+    /// stop 63; for comparison).
+    #[arg(long)]
+    pub(crate) any_not_colours: bool,
     /// Let a tuple on the objects line carry any colour word, not only a colour the
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
@@ -339,6 +344,7 @@ impl ModelArgs {
             answer_grammar: !self.no_grammar,
             said_only: !self.open_selections,
             said_colours: self.said_colours,
+            said_exclusions: !self.any_not_colours,
             said_tuple_colours: !self.any_tuple_colours,
             map_colours: !self.any_pick_colours,
             redraws: self.redraws,

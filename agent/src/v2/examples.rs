@@ -283,7 +283,10 @@ mod tests {
             let in_chat = e.history.is_some();
             let unsaid = super::super::check::unsaid_ordinals(&e.instruction, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
-            let unsaid = super::super::check::unsaid_regions(&e.instruction, in_chat, &a.plan);
+            let unsaid = super::super::check::unsaid_regions(&e.instruction, &[], in_chat, &a.plan);
+            assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
+            let unsaid =
+                super::super::check::unsaid_exclusions(&e.instruction, &[], in_chat, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let from_end = super::super::check::counted_from_the_end(&a.plan);
             assert!(from_end.is_empty(), "line {}: {from_end:?}", e.line);
