@@ -302,23 +302,11 @@ fn check_tuples(
     // one is the model's note, and the plan is judged on its own (held-out v7, dev,
     // hq08: `(crate, None, blue)` beside a right plan sent it to a re-ask that dropped
     // the cabinet, then a question).
-    let said_of = colour_nouns(map, instruction, pose);
-    let colour_words: Vec<String> = w
-        .iter()
-        .filter(|x| is_colour_word(x))
-        .filter_map(|x| normalise_colour(x))
-        .map(|c| canonical(&c))
-        .collect();
+    let mentions = colour_mentions(map, instruction, pose);
     let only_of_others = |c: &str, label: &str| {
         let c = canonical(c);
-        let of: Vec<&String> = said_of
-            .iter()
-            .filter(|(x, _)| *x == c)
-            .map(|(_, l)| l)
-            .collect();
-        !of.is_empty()
-            && of.len() == colour_words.iter().filter(|x| **x == c).count()
-            && of.iter().all(|l| *l != label)
+        let mut of = mentions.iter().filter(|(x, _)| *x == c).peekable();
+        of.peek().is_some() && of.all(|(_, l)| l.as_deref().is_some_and(|l| l != label))
     };
     for t in tuples {
         // A colour is not an object ("the sofa, the red one" listed as (red, ...)).
@@ -450,13 +438,21 @@ fn accounted_for(
 /// white chair": white, chair), as [`noun_after`] reads them (colours in their canonical
 /// spelling: grey as gray).
 pub(crate) fn colour_nouns(map: &IvlMap, instruction: &str, pose: Pose) -> Vec<(String, String)> {
+    colour_mentions(map, instruction, pose)
+        .into_iter()
+        .filter_map(|(c, label)| Some((c, label?)))
+        .collect()
+}
+
+/// Each colour word of the instruction (canonical spelling), with the label of the map
+/// object it is said of where [`noun_after`] reads one ("the sofa, the red one": none).
+fn colour_mentions(map: &IvlMap, instruction: &str, pose: Pose) -> Vec<(String, Option<String>)> {
     let w = words(instruction);
     (0..w.len())
         .filter(|&i| is_colour_word(&w[i]))
         .filter_map(|i| {
             let c = normalise_colour(&w[i])?;
-            let (_, label) = noun_after(map, &w, i, pose)?;
-            Some((canonical(&c), label))
+            Some((canonical(&c), noun_after(map, &w, i, pose).map(|(_, l)| l)))
         })
         .collect()
 }
