@@ -102,6 +102,10 @@ pub struct PlanOptions {
     /// excludes something, and only a colour they said (default on; `--any-not-colours`
     /// turns it off).
     pub said_exclusions: bool,
+    /// With `said_only`, outside a conversation: a pick may count in a directional order
+    /// only where the person said a direction of its object, in the clause naming it
+    /// (default on; `--directions-anywhere` turns it off).
+    pub directions_of_said: bool,
     /// The objects line's colours are the person's (default on; `--any-tuple-colours`
     /// turns it off).
     pub said_tuple_colours: bool,
@@ -154,6 +158,7 @@ impl Default for PlanOptions {
             said_only: true,
             said_colours: false,
             said_exclusions: true,
+            directions_of_said: true,
             said_tuple_colours: true,
             map_colours: true,
             redraws: 1,

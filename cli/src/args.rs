@@ -274,6 +274,11 @@ pub(crate) struct ModelArgs {
     /// stop 63; for comparison).
     #[arg(long)]
     pub(crate) any_not_colours: bool,
+    /// Let a pick of any object count in a directional order wherever the instruction
+    /// names a direction, not only one whose clause names it (the default before stop
+    /// 64; for comparison).
+    #[arg(long)]
+    pub(crate) directions_anywhere: bool,
     /// Let a tuple on the objects line carry any colour word, not only a colour the
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
@@ -345,6 +350,7 @@ impl ModelArgs {
             said_only: !self.open_selections,
             said_colours: self.said_colours,
             said_exclusions: !self.any_not_colours,
+            directions_of_said: !self.directions_anywhere,
             said_tuple_colours: !self.any_tuple_colours,
             map_colours: !self.any_pick_colours,
             redraws: self.redraws,

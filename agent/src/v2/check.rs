@@ -1621,6 +1621,30 @@ pub(crate) fn exclusion_said(instruction: &str) -> bool {
     words(instruction).iter().any(|w| excludes(w))
 }
 
+/// Whether a colour is one the person excludes: said ([`colour_said`], a typo counting)
+/// after a word that excludes ([`excludes`]) in the same clause ([`clauses`]), or one of
+/// the `known` colours where a word of `instruction` excludes something. "Then the white
+/// spotlight furthest west, then the microphone that isn't black" excludes black, not
+/// white: held-out v8 (dev since its third run) ht02 picked the spotlight
+/// `#{not_colour: "white", ...}`.
+pub(crate) fn excluded_colour_said<'a>(
+    instruction: &str,
+    known: &'a [String],
+) -> impl Fn(&str) -> bool + 'a {
+    let after: Vec<String> = clauses(instruction)
+        .into_iter()
+        .filter_map(|w| {
+            let i = w.iter().position(|x| excludes(x))?;
+            Some(w[i + 1..].join(" "))
+        })
+        .collect();
+    let text = after.join(" , ");
+    let any = exclusion_said(instruction);
+    let said = colour_said(&text, &[]);
+    let known = colour_said("", known);
+    move |c: &str| said(c) || (any && known(c))
+}
+
 /// Whether a word of `instruction` starts with one of `stems`.
 fn starts_a_word(instruction: &str, stems: &[&str]) -> bool {
     words(instruction)
@@ -1659,10 +1683,142 @@ pub(crate) fn unsaid_sizes<'a>(instruction: &str, plan: &'a TypedPlan) -> Vec<&'
 /// Whether a word of `instruction` names a side or a compass direction, which a
 /// directional order needs.
 pub(crate) fn direction_said(instruction: &str) -> bool {
-    starts_a_word(
-        instruction,
-        &["north", "south", "east", "west", "left", "right"],
-    )
+    starts_a_word(instruction, DIRECTION_STEMS)
+}
+
+/// The starts of words that name a side or a compass direction ([`direction_said`]).
+const DIRECTION_STEMS: &[&str] = &["north", "south", "east", "west", "left", "right"];
+
+/// Whether `word` names a side or a compass direction ("westernmost", "left").
+fn names_a_direction(word: &str) -> bool {
+    DIRECTION_STEMS.iter().any(|s| word.starts_with(s))
+}
+
+/// The clauses of `instruction`, each as its words ([`words`]): split at punctuation,
+/// at an arrow ("->") and at the words that join two requests ("then", "and", "after",
+/// "afterwards", "finally", and "next" but not "next to").
+pub(crate) fn clauses(instruction: &str) -> Vec<Vec<String>> {
+    let mut out: Vec<Vec<String>> = Vec::new();
+    let pieces = instruction.split(|c: char| {
+        matches!(
+            c,
+            ',' | '.' | ';' | ':' | '!' | '?' | '>' | '(' | ')' | '\n'
+        )
+    });
+    for piece in pieces {
+        let w: Vec<String> = words(piece)
+            .into_iter()
+            .filter(|x| x.chars().any(char::is_alphanumeric))
+            .collect();
+        let mut clause: Vec<String> = Vec::new();
+        for (i, x) in w.iter().enumerate() {
+            let joins = match x.as_str() {
+                "then" | "and" | "after" | "afterwards" | "finally" => true,
+                "next" => w.get(i + 1).map(String::as_str) != Some("to"),
+                _ => false,
+            };
+            if joins {
+                out.extend((!clause.is_empty()).then(|| std::mem::take(&mut clause)));
+            } else {
+                clause.push(x.clone());
+            }
+        }
+        out.extend((!clause.is_empty()).then_some(clause));
+    }
+    out
+}
+
+/// The objects a direction is said of: the labels (`name_at`: the label a name
+/// beginning at a word has, and its length in words) named in a clause ([`clauses`])
+/// that names a side or a compass direction ("the 2nd freezer counting from the west"),
+/// and for such a clause that names no object ("the chairs, the one furthest west",
+/// "counting from the east, the second mirror") those of the nearest clause before and
+/// after it that name one. `None` when no clause names a direction, or a clause that
+/// does names no object and no other clause names one.
+///
+/// Held-out v8 (dev since its third run) hr04: "the penultimate microscope first. Next
+/// the 2nd freezer counting from the west" counted the microscope west to east too; ht04
+/// ("the penultimate spotlight, then the second mirror counting from the east") counted
+/// the spotlight from the east.
+pub(crate) fn directions_said_of(
+    instruction: &str,
+    name_at: impl Fn(&[String], usize) -> Option<(String, usize)>,
+) -> Option<Vec<String>> {
+    let parts = clauses(instruction);
+    let named: Vec<Vec<String>> = parts
+        .iter()
+        .map(|w| {
+            let mut labels = Vec::new();
+            let mut j = 0;
+            while j < w.len() {
+                match name_at(w, j) {
+                    Some((label, len)) => {
+                        labels.push(label);
+                        j += len.max(1);
+                    }
+                    None => j += 1,
+                }
+            }
+            labels
+        })
+        .collect();
+    let mut out: Vec<String> = Vec::new();
+    let mut any = false;
+    for (i, w) in parts.iter().enumerate() {
+        if !w.iter().any(|x| names_a_direction(x)) {
+            continue;
+        }
+        any = true;
+        if !named[i].is_empty() {
+            out.extend(named[i].iter().cloned());
+            continue;
+        }
+        let before = named[..i].iter().rev().find(|l| !l.is_empty());
+        let after = named[i + 1..].iter().find(|l| !l.is_empty());
+        if before.is_none() && after.is_none() {
+            return None;
+        }
+        out.extend(before.into_iter().chain(after).flatten().cloned());
+    }
+    out.sort();
+    out.dedup();
+    any.then_some(out)
+}
+
+/// [`directions_said_of`] on `map`: the labels of the objects named in a clause that
+/// names a direction (a name the map holds, or a typo of one), regions left out.
+pub(crate) fn directions_said_of_map(
+    map: &IvlMap,
+    instruction: &str,
+    pose: Pose,
+) -> Option<Vec<String>> {
+    directions_said_of(instruction, |w, j| {
+        if let Some((_, label, len)) = label_at(map, w, j, pose) {
+            return Some((label, len));
+        }
+        if is_colour_word(&w[j]) {
+            return None;
+        }
+        typed_label_at(map, w, j).map(|(_, label)| (label, 1))
+    })
+}
+
+/// Targets counted in a direction whose object the person named in no clause that
+/// names one ([`directions_said_of`]: `said`), where a direction is said of some
+/// objects: the grammar offers the directional orders only to those
+/// (`v2::narrow_to_words`).
+pub(crate) fn directions_said_of_others<'a>(
+    said: Option<&[String]>,
+    plan: &'a TypedPlan,
+    label: impl Fn(&str) -> Option<String>,
+) -> Vec<&'a Target> {
+    let Some(said) = said else {
+        return Vec::new();
+    };
+    targets(plan)
+        .into_iter()
+        .filter(|t| t.order.is_directional() && label(&t.name).is_some_and(|l| !said.contains(&l)))
+        .collect()
 }
 
 /// Whether a word of `instruction` speaks of the far end ("the farthest", "furthest
@@ -1813,9 +1969,9 @@ pub(crate) fn unsaid_ordinals<'a>(instruction: &str, plan: &'a TypedPlan) -> Vec
         .collect()
 }
 
-/// Targets that exclude a colour (`not_colour`) where no word of `instruction` excludes
-/// anything ([`exclusion_said`]): the grammar offers `not_colour` only where one does
-/// (`v2::narrow_exclusions`). A colour the person never said is [`unsaid_colours`]'
+/// Targets that exclude a colour (`not_colour`) the person does not exclude
+/// ([`excluded_colour_said`]: said after a word that excludes, in its clause): the grammar
+/// offers `not_colour` only with those (`v2::narrow_exclusions`). A colour the person never said is [`unsaid_colours`]'
 /// finding, not this one; `known` as there. In a conversation (`in_chat`) not judged.
 /// No worked example may have one.
 pub(crate) fn unsaid_exclusions<'a>(
@@ -1824,13 +1980,18 @@ pub(crate) fn unsaid_exclusions<'a>(
     in_chat: bool,
     plan: &'a TypedPlan,
 ) -> Vec<&'a Target> {
-    if in_chat || exclusion_said(instruction) {
+    if in_chat {
         return Vec::new();
     }
     let said = colour_said(instruction, known);
+    let excluded = excluded_colour_said(instruction, known);
     targets(plan)
         .into_iter()
-        .filter(|t| t.not_colour.as_deref().is_some_and(&said))
+        .filter(|t| {
+            t.not_colour
+                .as_deref()
+                .is_some_and(|c| said(c) && !excluded(c))
+        })
         .collect()
 }
 
@@ -1854,7 +2015,7 @@ pub(crate) fn end_reads_as_said(order: ObjectOrder) -> bool {
 }
 
 /// What a finding tells the model about a target.
-type Note = dyn Fn(&Target) -> String;
+type Note<'a> = dyn Fn(&Target) -> String + 'a;
 
 /// Findings for targets that select on something the person did not say, one per
 /// distinct message: `to_model` says what to leave out, the question names the object's
@@ -1897,6 +2058,37 @@ fn object_mentions(map: &IvlMap, w: &[String], pose: Pose) -> Vec<(usize, String
     out
 }
 
+/// The labels `plan` stops at or faces, and each such pick's anchor (its label, the
+/// anchor's label).
+fn stops_and_anchors(
+    map: &IvlMap,
+    plan: &TypedPlan,
+    pose: Pose,
+) -> (Vec<String>, Vec<(String, String)>) {
+    let mut stops: Vec<String> = Vec::new();
+    let mut anchored: Vec<(String, String)> = Vec::new();
+    for step in &plan.steps {
+        for o in step.objects() {
+            let Some(t) = picked(plan, o) else {
+                if let Object::Name(n) = o {
+                    stops.extend(object_label(map, n, pose));
+                }
+                continue;
+            };
+            let Some(label) = object_label(map, &t.name, pose) else {
+                continue;
+            };
+            if let Some(Object::Pick(a)) = t.near.as_deref() {
+                if let Some(anchor) = object_label(map, &a.name, pose) {
+                    anchored.push((label.clone(), anchor));
+                }
+            }
+            stops.push(label);
+        }
+    }
+    (stops, anchored)
+}
+
 /// The pick a step's object makes: a pick, or the pick a variable was bound to.
 fn picked<'a>(plan: &'a TypedPlan, o: &'a Object) -> Option<&'a Target> {
     match o {
@@ -1936,28 +2128,7 @@ fn check_anchor_stops(
             .map(|(k, _)| *k)
             .collect()
     };
-    // The labels the plan stops at or faces, and each stop's anchor.
-    let mut stops: Vec<String> = Vec::new();
-    let mut anchored: Vec<(String, String)> = Vec::new();
-    for step in &plan.steps {
-        for o in step.objects() {
-            let Some(t) = picked(plan, o) else {
-                if let Object::Name(n) = o {
-                    stops.extend(object_label(map, n, pose));
-                }
-                continue;
-            };
-            let Some(label) = object_label(map, &t.name, pose) else {
-                continue;
-            };
-            if let Some(Object::Pick(a)) = t.near.as_deref() {
-                if let Some(anchor) = object_label(map, &a.name, pose) {
-                    anchored.push((label.clone(), anchor));
-                }
-            }
-            stops.push(label);
-        }
-    }
+    let (stops, anchored) = stops_and_anchors(map, plan, pose);
     let mut out = Vec::new();
     // An object picked near another of its kind that the person named once (held-out
     // v4, dev, hj14: "the stool nearest to you" as the stool nearest the first stool).
@@ -2023,8 +2194,9 @@ fn check_anchor_stops(
 
 /// Picks near an object the person never named, by a name or a synonym of it or a typo
 /// of one ("the cabinet nearest to you" as the cabinet `near: get_obj("workbench")`:
-/// held-out v7, dev, hq13, a wrong plan no check saw). Outside a conversation, where an
-/// earlier instruction may have named it.
+/// held-out v7, dev, hq13, a wrong plan no check saw), or named only later as a stop of
+/// its own ([`named_later_as_a_stop`]). Outside a conversation, where an earlier
+/// instruction may have named it.
 fn check_unsaid_anchors(
     map: &IvlMap,
     instruction: &str,
@@ -2039,6 +2211,16 @@ fn check_unsaid_anchors(
                 .or_else(|| typed_label_at(map, &w, k).map(|(_, l)| l))
         })
         .collect();
+    let clause_labels: Vec<Vec<String>> = clauses(instruction)
+        .iter()
+        .map(|c| {
+            object_mentions(map, c, pose)
+                .into_iter()
+                .map(|(_, l)| l)
+                .collect()
+        })
+        .collect();
+    let (stops, _) = stops_and_anchors(map, plan, pose);
     let mut out: Vec<Finding> = Vec::new();
     for t in targets(plan) {
         let Some(Object::Pick(a)) = t.near.as_deref() else {
@@ -2050,19 +2232,52 @@ fn check_unsaid_anchors(
         ) else {
             continue;
         };
-        if said.contains(&anchor) {
+        let f = if !said.contains(&anchor) {
+            Finding::new(
+                FindingKind::Word,
+                format!("the plan picks the {label} near a {anchor}, but the person named no {anchor}: give near only an object the person named (with no near, distances are from the robot)"),
+                format!("which {label} do you mean? there are {}", describe_label(map, &label)),
+            )
+        } else if named_later_as_a_stop(&clause_labels, &stops, &label, &anchor) {
+            Finding::new(
+                FindingKind::Word,
+                format!("the plan picks the {label} near the {anchor}, but the person named the {anchor} once, later, as a stop of its own: pick the {label} as their words about it say (with no near, distances are from the robot)"),
+                format!("which {label} do you mean? there are {}", describe_label(map, &label)),
+            )
+        } else {
             continue;
-        }
-        let f = Finding::new(
-            FindingKind::Word,
-            format!("the plan picks the {label} near a {anchor}, but the person named no {anchor}: give near only an object the person named (with no near, distances are from the robot)"),
-            format!("which {label} do you mean? there are {}", describe_label(map, &label)),
-        );
+        };
         if !out.contains(&f) {
             out.push(f);
         }
     }
     out
+}
+
+/// Whether `anchor` is named once, in a clause after every clause that names `label`
+/// (`clause_labels`: the labels each clause names, in order), and the plan also stops at
+/// it (`stops`): "whichever mirror is nearest you, then stop on the left of the green
+/// stool" (held-out v8, dev since its third run, ht14: the mirror picked near the stool,
+/// a wrong plan no check saw). "The chair, the one closest to the sofa" picks near the
+/// sofa too, but no plan that reads it so stops at the sofa.
+fn named_later_as_a_stop(
+    clause_labels: &[Vec<String>],
+    stops: &[String],
+    label: &str,
+    anchor: &str,
+) -> bool {
+    let at = |l: &str| -> Vec<usize> {
+        clause_labels
+            .iter()
+            .enumerate()
+            .flat_map(|(i, ls)| ls.iter().filter(|x| *x == l).map(move |_| i))
+            .collect()
+    };
+    let (at_anchor, at_label) = (at(anchor), at(label));
+    match (at_anchor.as_slice(), at_label.last()) {
+        ([a], Some(l)) => a > l && stops.iter().any(|s| s == anchor),
+        _ => false,
+    }
 }
 
 /// Everything found in `plan` and `tuples` for `instruction` on `map`. `visited` holds
@@ -2149,11 +2364,25 @@ pub fn check_answer_after(
     let ordinals = |t: &Target| {
         format!("the plan picks the {} with ordinal {}, but the person said no such count: leave the ordinal out unless their words count (\"the third\", \"number 3\", \"second to last\")", t.name, t.ordinal)
     };
+    let excluding = exclusion_said(&allowed);
     let exclusions = |t: &Target| {
         let c = t.not_colour.as_deref().unwrap_or_default();
-        format!("the plan picks the {} that is not {c}, but the person excluded nothing: leave not_colour out unless their words exclude a colour (\"not\", \"isn't\", \"other than\")", t.name)
+        let what = if excluding {
+            format!("did not exclude {c}")
+        } else {
+            "excluded nothing".to_string()
+        };
+        format!("the plan picks the {} that is not {c}, but the person {what}: leave not_colour out unless their words exclude a colour (\"not\", \"isn't\", \"other than\")", t.name)
     };
-    let unsaid: [(Vec<&Target>, &Note, &str); 6] = [
+    // Outside a conversation, where a direction is said of some objects only.
+    let directed = (refs.is_empty() && earlier.is_none())
+        .then(|| directions_said_of_map(map, instruction, pose))
+        .flatten();
+    let others = |t: &Target| {
+        let of = directed.as_deref().unwrap_or_default().join(", the ");
+        format!("the plan counts the {} in order \"{}\", but the person named a direction only for the {of}: leave the {}'s order out (nearest first) unless their words about it give one", t.name, t.order.name(), t.name)
+    };
+    let unsaid: [(Vec<&Target>, &Note<'_>, &str); 7] = [
         (
             unsaid_directions(&allowed, plan),
             &directions,
@@ -2171,6 +2400,11 @@ pub fn check_answer_after(
             unsaid_exclusions(&allowed, &known, in_chat, plan),
             &exclusions,
             "",
+        ),
+        (
+            directions_said_of_others(directed.as_deref(), plan, |n| object_label(map, n, pose)),
+            &others,
+            ", counting from where",
         ),
     ];
     for (targets, to_model, how) in unsaid {
@@ -2854,7 +3088,97 @@ pub(crate) mod tests {
             "a table other than the white one",
         ] {
             assert_no_finding(said, "table", "#{not_colour: \"white\"}", says);
+            assert_no_finding(said, "table", "#{not_colour: \"white\"}", "did not exclude");
         }
+        // Said, but not after the excluding word (held-out v8, dev, ht02).
+        assert_word_finding(
+            "the white desk, then the table that isn't black",
+            "table",
+            "#{not_colour: \"white\"}",
+            "but the person did not exclude white",
+        );
+        assert_no_finding(
+            "the white desk, then the table that isn't black",
+            "table",
+            "#{not_colour: \"black\"}",
+            "did not exclude",
+        );
+    }
+
+    #[test]
+    fn clauses_end_at_punctuation_arrows_and_joining_words() {
+        let c =
+            clauses("the sofa, then the table -> the chair next to the tv and the bed. Next: go");
+        let c: Vec<String> = c.iter().map(|w| w.join(" ")).collect();
+        assert_eq!(
+            c,
+            [
+                "the sofa",
+                "the table",
+                "the chair next to the tv",
+                "the bed",
+                "go"
+            ]
+        );
+    }
+
+    #[test]
+    fn a_direction_is_said_of_the_objects_of_its_clause() {
+        let m = map();
+        let of = |s: &str| directions_said_of_map(&m, s, m.start_pose);
+        // Held-out v8 (dev) hr04 and ht04, on flat-a's names.
+        assert_eq!(
+            of("the penultimate chair first. Next the 2nd table counting from the west"),
+            Some(vec!["table".to_string()])
+        );
+        assert_eq!(
+            of("the second to last sofa, then the second chair counting from the east, then the bed"),
+            Some(vec!["chair".to_string()])
+        );
+        // A clause naming no object: the objects of the clauses around it.
+        assert_eq!(
+            of("the chairs, the one furthest west"),
+            Some(vec!["chair".to_string()])
+        );
+        assert_eq!(
+            of("the sofa, then counting from the east, the second chair"),
+            Some(vec!["chair".to_string(), "sofa".to_string()])
+        );
+        // A synonym, a typo and a two-word name count as their labels.
+        assert_eq!(
+            of("the couch furthest north, then the tabel on the left"),
+            Some(vec!["sofa".to_string(), "table".to_string()])
+        );
+        // No direction said: none; a direction of no object anywhere: no narrowing.
+        assert_eq!(of("the third chair, then the sofa"), None);
+        assert_eq!(of("turn left"), None);
+    }
+
+    #[test]
+    fn a_count_in_a_direction_said_of_another_object_is_a_finding() {
+        let says = "but the person named a direction only for the table";
+        let instruction = "the penultimate chair first, then the 2nd table counting from the west";
+        let f = findings(
+            instruction,
+            "objects: [(chair, None, None), (table, 2, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, order: \"west_to_east\"}));\nmove_to_object(get_obj(\"table\", #{ordinal: 2, order: \"west_to_east\"}));",
+        );
+        assert!(
+            f.iter().any(|x| x.to_model.contains(says)
+                && x.to_model
+                    .contains("counts the chair in order \"west_to_east\"")),
+            "{f:?}"
+        );
+        assert!(
+            f.iter().all(|x| !x.to_model.contains("counts the table")),
+            "{f:?}"
+        );
+        // Said of the chair: no finding.
+        assert_no_finding(
+            "go to the second chair from the west, then the sofa",
+            "chair",
+            "#{ordinal: 2, order: \"west_to_east\"}",
+            "named a direction only",
+        );
     }
 
     #[test]
@@ -2879,6 +3203,37 @@ pub(crate) mod tests {
             let f = findings(said, &pick("sofa"));
             assert!(
                 f.iter().all(|x| !x.to_model.contains("named no sofa")),
+                "{said}: {f:?}"
+            );
+        }
+        // Named once, later, as a stop of its own (held-out v8, dev, ht14).
+        let later = "as a stop of its own";
+        let stop_too = format!("{}\nmove_to_left(get_obj(\"sofa\"));", pick("sofa"));
+        let f = findings(
+            "go to the chair nearest to you, then stop on the left of the sofa",
+            &stop_too,
+        );
+        assert!(
+            f.iter()
+                .any(|x| x.to_model.contains("picks the chair near the sofa")
+                    && x.to_model.contains(later)),
+            "{f:?}"
+        );
+        // Not a stop, said in the same clause, or named before the chair: no finding.
+        for (said, answer) in [
+            ("go to the chair, the one closest to the sofa", pick("sofa")),
+            (
+                "go to the chair closest to the sofa, then the left of the sofa",
+                stop_too.clone(),
+            ),
+            (
+                "stop on the left of the sofa, then the chair nearest it",
+                stop_too.clone(),
+            ),
+        ] {
+            let f = findings(said, &answer);
+            assert!(
+                f.iter().all(|x| !x.to_model.contains(later)),
                 "{said}: {f:?}"
             );
         }

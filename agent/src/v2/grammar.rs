@@ -41,6 +41,10 @@ pub struct Vocabulary {
     pub no_sizes: bool,
     /// Offer no `far_to_near` order (farthest first).
     pub no_far_end: bool,
+    /// The names a pick may count in a directional order (`None`: every name, unless
+    /// `no_directions`): outside a conversation, those the person said a direction of
+    /// ([`check::directions_said_of`](super::check::directions_said_of)).
+    pub directions_of: Option<Vec<String>>,
     /// Names whose picks must select on a colour (`colour:`, one of the name's colours
     /// in [`Vocabulary::colours_of`]): a re-ask after a said colour the plan dropped
     /// ([`check::Bar::ColourDropped`](super::check::Bar::ColourDropped)).
@@ -199,6 +203,7 @@ impl Vocabulary {
             no_directions: false,
             no_sizes: false,
             no_far_end: false,
+            directions_of: None,
             colour_required: Vec::new(),
             colour_key_required: Vec::new(),
             colours_of: None,
@@ -625,6 +630,9 @@ struct SelKeys<'a> {
     colour_required: bool,
     /// The map ends only after a `colour:` or `not_colour:` key (only with `colour`).
     colour_key_required: bool,
+    /// The suffix of the order rules: `""` for `qorder`, `qordern` and `qorderf`, `"d"`
+    /// for those less the directional orders ([`PickGroup::no_directions`]).
+    orders: &'a str,
 }
 
 impl SelKeys<'_> {
@@ -672,8 +680,12 @@ impl SelKeys<'_> {
             }
         }
         if open(KEY_ORDER) {
-            let order =
-                |rule: &str, pending| (format!("\"order: \" {rule}"), after(KEY_ORDER, pending));
+            let order = |rule: &str, pending| {
+                (
+                    format!("\"order: \" {rule}{}", self.orders),
+                    after(KEY_ORDER, pending),
+                )
+            };
             if s.pending == Pending::OrderFromEnd {
                 out.push(order("qordern", Pending::Nothing));
             } else if !open(KEY_ORDINAL) || !self.negative {
@@ -731,6 +743,9 @@ impl SelKeys<'_> {
 /// farthest away" as `#{ordinal: -1, order: "far_to_near"}`, the nearest bed; "the
 /// biggest bed" as the last largest-first, the smallest): one way to write each
 /// meaning, the one that reads as it is said ([`check`](super::check) finds the other).
+///
+/// With `no_directions` its orders are those less the directional ones (rules
+/// `qorderd`, `qordernd`, `qorderfd`: [`PickGroup::no_directions`]).
 fn selection_rules(
     w: &mut Writer,
     suffix: &str,
@@ -738,7 +753,7 @@ fn selection_rules(
     region: Option<&str>,
     vocab: &Vocabulary,
     not_from_end: bool,
-    (colour_required, colour_key_required): (bool, bool),
+    (colour_required, colour_key_required, no_directions): (bool, bool, bool),
 ) {
     let (positive, negative) = ordinal_signs(vocab);
     let keys = SelKeys {
@@ -750,6 +765,7 @@ fn selection_rules(
         not_from_end,
         colour_required: colour_required && colour.is_some(),
         colour_key_required: colour_key_required && colour.is_some(),
+        orders: if no_directions { "d" } else { "" },
     };
     let name = |s: SelState| {
         let pending = match s.pending {
@@ -821,6 +837,9 @@ struct PickGroup {
     /// Its picks must select on a colour or exclude one
     /// ([`Vocabulary::colour_key_required`]); only where it has a colour to offer.
     colour_key_required: bool,
+    /// Its picks count in no directional order: the vocabulary offers those only to
+    /// other names ([`Vocabulary::directions_of`]).
+    no_directions: bool,
 }
 
 /// The list of the group holding `name` in `groups` ([`Vocabulary::colours_of`],
@@ -849,6 +868,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
         && vocab.regions_of.is_none()
         && vocab.colour_required.is_empty()
         && vocab.colour_key_required.is_empty()
+        && vocab.directions_of.is_none()
     {
         return None;
     }
@@ -885,12 +905,17 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
             .map_or(!vocab.colours.is_empty(), |c| !c.is_empty());
         let colour_required = vocab.colour_required.contains(name) && has_colours;
         let colour_key_required = vocab.colour_key_required.contains(name) && has_colours;
+        let no_directions = vocab
+            .directions_of
+            .as_ref()
+            .is_some_and(|d| !d.contains(name));
         match groups.iter_mut().find(|g| {
             g.colours == colours
                 && g.not_colours == not_colours
                 && g.regions == regions
                 && g.colour_required == colour_required
                 && g.colour_key_required == colour_key_required
+                && g.no_directions == no_directions
         }) {
             Some(g) => g.names.push(name.clone()),
             None => groups.push(PickGroup {
@@ -900,6 +925,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
                 regions,
                 colour_required,
                 colour_key_required,
+                no_directions,
             }),
         }
     }
@@ -979,7 +1005,11 @@ fn group_rules(
         regions.as_deref(),
         vocab,
         not_from_end,
-        (group.colour_required, group.colour_key_required),
+        (
+            group.colour_required,
+            group.colour_key_required,
+            group.no_directions,
+        ),
     );
 }
 
@@ -1270,6 +1300,24 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     if !not_from_end.is_empty() {
         w.rule("qorderf", &alt(&not_from_end, true));
     }
+    // The same less the directional orders, for the picks of names no direction is said
+    // of ([`PickGroup::no_directions`]); `far_to_near` and those by size are none.
+    let undirected = |list: &[&'static str]| -> Vec<&'static str> {
+        list.iter()
+            .copied()
+            .filter(|o| ObjectOrder::parse(o).is_ok_and(|o| !o.is_directional()))
+            .collect()
+    };
+    let groups_undirected = [&groups, &pair_groups]
+        .iter()
+        .any(|g| g.iter().flatten().any(|g| g.no_directions));
+    if groups_undirected {
+        w.rule("qorderd", &alt(&undirected(&offered), true));
+        w.rule("qordernd", &alt(&undirected(&from_end), true));
+        if !not_from_end.is_empty() {
+            w.rule("qorderfd", &alt(&undirected(&not_from_end), true));
+        }
+    }
     let all_colours = (!vocab.colours.is_empty()).then_some("qcolour");
     let all_regions = (!keys.is_empty()).then_some("qregion");
     let not_from_end = !not_from_end.is_empty();
@@ -1292,7 +1340,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             all_regions,
             vocab,
             not_from_end,
-            (false, false),
+            (false, false, false),
         );
     }
     for (tag, gs) in [("", &groups), ("p", &pair_groups)] {
