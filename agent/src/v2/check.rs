@@ -643,7 +643,6 @@ fn check_words(
     let mut said: Vec<String> = Vec::new();
     for (i, word) in w.iter().enumerate() {
         let prev = if i > 0 { w[i - 1].as_str() } else { "" };
-        let next = w.get(i + 1).map_or("", String::as_str);
         if word == "from" {
             out.extend(counted_from_a_side(&w, i, &any_target));
             continue;
@@ -732,7 +731,8 @@ fn check_words(
             // north-first (Qwen 1.5B on held-out v2 wrote "the shelf furthest north" as
             // ordinal -1 in north_to_south, the southernmost, and a check that saw only
             // a direction let it pass).
-            if let Some(o) = ObjectOrder::starting_at(next) {
+            if let Some((j, o)) = side_after(&w, i) {
+                let side = &w[j];
                 // On the object it is said of, when that object's name comes right before
                 // ("the desk furthest west"; held-out v2: another target's order let the
                 // desk's wrong end pass).
@@ -742,7 +742,7 @@ fn check_words(
                 let counted = |t: &Target| from_end(t, o) && on_noun(t);
                 if !any_target(&counted) {
                     let ordered = any_target(&|t| t.order == o || t.order == o.reversed());
-                    let f = not_counted_from(&format!("{word} {next}"), o, ordered);
+                    let f = not_counted_from(&format!("{word} {side}"), o, ordered);
                     out.push(match ends_said_of_sides(&w) {
                         true => f.barring(Bar::CountFromStart),
                         false => f,
@@ -980,7 +980,7 @@ fn counted_from_a_side(w: &[String], at: usize, any_target: &AnyTarget<'_>) -> V
 }
 
 /// Whether every count from the end that `w` says ([`counts_from_the_end`]: "last",
-/// "furthest", "penultimate") is "furthest" (or "farthest") right before a side ("the
+/// "furthest", "penultimate") is "furthest" (or "farthest") before a side ([`side_after`]: "the
 /// shelf furthest north"): a positive count in the order starting at that side says
 /// each ([`Bar::CountFromStart`]). "The farthest bin", "the last chair", "the most
 /// distant chair" ([`speaks_of_the_far_end`], as [`far_end_said`] reads it) and "the
@@ -989,10 +989,24 @@ fn counted_from_a_side(w: &[String], at: usize, any_target: &AnyTarget<'_>) -> V
 pub(crate) fn ends_said_of_sides(w: &[String]) -> bool {
     w.iter().enumerate().all(|(j, x)| {
         !(counts_from_the_end(x) || speaks_of_the_far_end(x))
-            || (matches!(x.as_str(), "furthest" | "farthest")
-                && w.get(j + 1)
-                    .is_some_and(|x| ObjectOrder::starting_at(x).is_some()))
+            || (matches!(x.as_str(), "furthest" | "farthest") && side_after(w, j).is_some())
     })
+}
+
+/// The side that "furthest" at `i` counts from, and where it is said: a side named in
+/// the three words after it ("the shelf furthest north", "the white microscope furthest
+/// to the east"), before any "from", "then" or "and" ("the chair furthest from you on the
+/// left" counts from the robot). Held-out v8 (dev since its third run) hr11: with only
+/// the next word read, "furthest to the east" answered `#{colour: "white", order:
+/// "east_to_west"}` (the easternmost, right) was re-asked for a far end and ended in a
+/// question.
+fn side_after(w: &[String], i: usize) -> Option<(usize, ObjectOrder)> {
+    w.iter()
+        .enumerate()
+        .skip(i + 1)
+        .take(3)
+        .take_while(|(_, x)| !matches!(x.as_str(), "from" | "then" | "and"))
+        .find_map(|(j, x)| ObjectOrder::starting_at(x).map(|o| (j, o)))
 }
 
 /// Whether the person counts from an end only as "furthest" + a side, and says one
@@ -2662,6 +2676,11 @@ pub(crate) mod tests {
                 "#{ordinal: -1}",
                 "no object in the plan is counted in the order \"east_to_west\"",
             ),
+            (
+                "go to the table furthest to the east",
+                "#{ordinal: -1}",
+                "no object in the plan is counted in the order \"east_to_west\"",
+            ),
         ] {
             let object = if instruction.contains("bed") {
                 "bed"
@@ -2697,7 +2716,19 @@ pub(crate) mod tests {
                 "go to the bed furthest north",
                 "#{ordinal: -1, order: \"south_to_north\"}",
             ),
-            ("go to the bed furthest to the left", "#{ordinal: -1}"),
+            // A side a word or two later ([`side_after`]; held-out v8, dev, hr11).
+            (
+                "go to the bed furthest to the left",
+                "#{ordinal: 1, order: \"left_to_right\"}",
+            ),
+            (
+                "go to the bed furthest to the east",
+                "#{order: \"east_to_west\"}",
+            ),
+            (
+                "go to the bed furthest from you on the left",
+                "#{ordinal: -1}",
+            ),
         ] {
             let f = findings_for_pick(instruction, "bed", select);
             assert!(
@@ -3377,10 +3408,12 @@ pub(crate) mod tests {
     fn a_count_from_the_end_may_be_said_of_a_side_only() {
         for (instruction, of_sides) in [
             ("the shelf furthest north, then the red chair", true),
+            // A side a word or two after "furthest" ([`side_after`]).
             (
                 "the chair furthest to the left, the desk farthest south",
-                false,
+                true,
             ),
+            ("the chair furthest from you on the left", false),
             ("the second to last shelf from the west", false),
             (
                 "the desk furthest south, the last chair from the left",

@@ -1331,6 +1331,19 @@ mod tests {
             ],
             &[r#""chair", #{ordinal: 2, order: "west_to_east"}"#],
         );
+        // The objects line too.
+        grammar::tests::assert_offers(
+            &narrowed_grammar(
+                "the penultimate chair first, then the 2nd table counting from the west",
+            ),
+            |t| format!("objects: [{t}]\nplan:\nmove_to_object(get_obj(\"table\"));"),
+            &[
+                "(table, 2, None, west_to_east)",
+                "(chair, 2, None, far_to_near)",
+                "(chair, 2, None)",
+            ],
+            &["(chair, 2, None, west_to_east)"],
+        );
     }
 
     #[test]
