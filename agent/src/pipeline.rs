@@ -106,6 +106,10 @@ pub struct PlanOptions {
     /// only where the person said a direction of its object, in the clause naming it
     /// (default on; `--directions-anywhere` turns it off).
     pub directions_of_said: bool,
+    /// With `said_only`, outside a conversation: a pick may count two or more (either
+    /// end) only where the person said a count of its object, in the clause naming it
+    /// (default on; `--counts-anywhere` turns it off).
+    pub counts_of_said: bool,
     /// The objects line's colours are the person's (default on; `--any-tuple-colours`
     /// turns it off).
     pub said_tuple_colours: bool,
@@ -159,6 +163,7 @@ impl Default for PlanOptions {
             said_colours: false,
             said_exclusions: true,
             directions_of_said: true,
+            counts_of_said: true,
             said_tuple_colours: true,
             map_colours: true,
             redraws: 1,

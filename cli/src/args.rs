@@ -279,6 +279,11 @@ pub(crate) struct ModelArgs {
     /// 64; for comparison).
     #[arg(long)]
     pub(crate) directions_anywhere: bool,
+    /// Let a pick of any object count two or more wherever the instruction says such a
+    /// count, not only one whose clause says it (the default before stop 64; for
+    /// comparison).
+    #[arg(long)]
+    pub(crate) counts_anywhere: bool,
     /// Let a tuple on the objects line carry any colour word, not only a colour the
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
@@ -351,6 +356,7 @@ impl ModelArgs {
             said_colours: self.said_colours,
             said_exclusions: !self.any_not_colours,
             directions_of_said: !self.directions_anywhere,
+            counts_of_said: !self.counts_anywhere,
             said_tuple_colours: !self.any_tuple_colours,
             map_colours: !self.any_pick_colours,
             redraws: self.redraws,

@@ -1742,20 +1742,49 @@ pub(crate) fn clauses(instruction: &str) -> Vec<Vec<String>> {
     out
 }
 
-/// The objects a direction is said of: the labels (`name_at`: the label a name
-/// beginning at a word has, and its length in words) named in a clause ([`clauses`])
-/// that names a side or a compass direction ("the 2nd freezer counting from the west"),
+/// What a clause may say of the objects it names, and only of those.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum SaidOf {
+    /// A side or a compass direction ("the 2nd freezer counting from the west"): a
+    /// directional order. Held-out v8 (dev since its third run) hr04: "the penultimate
+    /// microscope first. Next the 2nd freezer counting from the west" counted the
+    /// microscope west to east too; ht04 counted "the penultimate spotlight" from the
+    /// east said of the next mirror.
+    Direction,
+    /// A count of two or more ([`said_count`]: "2nd", "third", "penultimate"): an
+    /// ordinal of two or more from either end ("the first", "the last" are said in too
+    /// many ways to place). Held-out v8 (dev) ht12: "piano, purple costume rack, 2nd
+    /// stool from the west" wrote the stool's 2 on the costume rack too.
+    Count,
+}
+
+impl SaidOf {
+    /// Whether `word` says it.
+    fn in_word(self, word: &str) -> bool {
+        match self {
+            SaidOf::Direction => names_a_direction(word),
+            SaidOf::Count => said_count(word).is_some_and(|k| k.abs() >= 2),
+        }
+    }
+
+    /// Whether target `t` selects with it.
+    fn in_target(self, t: &Target) -> bool {
+        match self {
+            SaidOf::Direction => t.order.is_directional(),
+            SaidOf::Count => t.ordinal.abs() >= 2,
+        }
+    }
+}
+
+/// The objects `what` is said of: the labels (`name_at`: the label a name beginning at
+/// a word has, and its length in words) named in a clause ([`clauses`]) that says it,
 /// and for such a clause that names no object ("the chairs, the one furthest west",
-/// "counting from the east, the second mirror") those of the nearest clause before and
-/// after it that name one. `None` when no clause names a direction, or a clause that
-/// does names no object and no other clause names one.
-///
-/// Held-out v8 (dev since its third run) hr04: "the penultimate microscope first. Next
-/// the 2nd freezer counting from the west" counted the microscope west to east too; ht04
-/// ("the penultimate spotlight, then the second mirror counting from the east") counted
-/// the spotlight from the east.
-pub(crate) fn directions_said_of(
+/// "counting from the east, the second mirror") those of the nearest clauses before
+/// and after it that name one. `None` when no clause says it, or a clause that does
+/// names no object and no other clause names one.
+pub(crate) fn said_of(
     instruction: &str,
+    what: SaidOf,
     name_at: impl Fn(&[String], usize) -> Option<(String, usize)>,
 ) -> Option<Vec<String>> {
     let parts = clauses(instruction);
@@ -1779,7 +1808,7 @@ pub(crate) fn directions_said_of(
     let mut out: Vec<String> = Vec::new();
     let mut any = false;
     for (i, w) in parts.iter().enumerate() {
-        if !w.iter().any(|x| names_a_direction(x)) {
+        if !w.iter().any(|x| what.in_word(x)) {
             continue;
         }
         any = true;
@@ -1799,14 +1828,15 @@ pub(crate) fn directions_said_of(
     any.then_some(out)
 }
 
-/// [`directions_said_of`] on `map`: the labels of the objects named in a clause that
-/// names a direction (a name the map holds, or a typo of one), regions left out.
-pub(crate) fn directions_said_of_map(
+/// [`said_of`] on `map`: a name is one the map holds (not a region), else a typo of one
+/// (not a colour word).
+pub(crate) fn said_of_map(
     map: &IvlMap,
     instruction: &str,
     pose: Pose,
+    what: SaidOf,
 ) -> Option<Vec<String>> {
-    directions_said_of(instruction, |w, j| {
+    said_of(instruction, what, |w, j| {
         if let Some((_, label, len)) = label_at(map, w, j, pose) {
             return Some((label, len));
         }
@@ -1817,12 +1847,12 @@ pub(crate) fn directions_said_of_map(
     })
 }
 
-/// Targets counted in a direction whose object the person named in no clause that
-/// names one ([`directions_said_of`]: `said`), where a direction is said of some
-/// objects: the grammar offers the directional orders only to those
-/// (`v2::narrow_to_words`).
-pub(crate) fn directions_said_of_others<'a>(
+/// Targets that select with `what` whose object (`label` reads a target's name) the
+/// person named in no clause that says it (`said`, from [`said_of`]): the grammar
+/// offers it only to those (`v2::narrow_to_words`).
+pub(crate) fn said_of_others<'a>(
     said: Option<&[String]>,
+    what: SaidOf,
     plan: &'a TypedPlan,
     label: impl Fn(&str) -> Option<String>,
 ) -> Vec<&'a Target> {
@@ -1831,7 +1861,7 @@ pub(crate) fn directions_said_of_others<'a>(
     };
     targets(plan)
         .into_iter()
-        .filter(|t| t.order.is_directional() && label(&t.name).is_some_and(|l| !said.contains(&l)))
+        .filter(|t| what.in_target(t) && label(&t.name).is_some_and(|l| !said.contains(&l)))
         .collect()
 }
 
@@ -2390,13 +2420,20 @@ pub fn check_answer_after(
     };
     // Outside a conversation, where a direction is said of some objects only.
     let directed = (refs.is_empty() && earlier.is_none())
-        .then(|| directions_said_of_map(map, instruction, pose))
+        .then(|| said_of_map(map, instruction, pose, SaidOf::Direction))
         .flatten();
     let others = |t: &Target| {
         let of = directed.as_deref().unwrap_or_default().join(", the ");
         format!("the plan counts the {} in order \"{}\", but the person named a direction only for the {of}: leave the {}'s order out (nearest first) unless their words about it give one", t.name, t.order.name(), t.name)
     };
-    let unsaid: [(Vec<&Target>, &Note<'_>, &str); 7] = [
+    let counted = (refs.is_empty() && earlier.is_none())
+        .then(|| said_of_map(map, instruction, pose, SaidOf::Count))
+        .flatten();
+    let counts_of_others = |t: &Target| {
+        let of = counted.as_deref().unwrap_or_default().join(", the ");
+        format!("the plan picks the {} with ordinal {}, but the person said a count only of the {of}: leave the {}'s ordinal out unless their words about it count", t.name, t.ordinal, t.name)
+    };
+    let unsaid: [(Vec<&Target>, &Note<'_>, &str); 8] = [
         (
             unsaid_directions(&allowed, plan),
             &directions,
@@ -2416,9 +2453,18 @@ pub fn check_answer_after(
             "",
         ),
         (
-            directions_said_of_others(directed.as_deref(), plan, |n| object_label(map, n, pose)),
+            said_of_others(directed.as_deref(), SaidOf::Direction, plan, |n| {
+                object_label(map, n, pose)
+            }),
             &others,
             ", counting from where",
+        ),
+        (
+            said_of_others(counted.as_deref(), SaidOf::Count, plan, |n| {
+                object_label(map, n, pose)
+            }),
+            &counts_of_others,
+            "",
         ),
     ];
     for (targets, to_model, how) in unsaid {
@@ -3156,7 +3202,7 @@ pub(crate) mod tests {
     #[test]
     fn a_direction_is_said_of_the_objects_of_its_clause() {
         let m = map();
-        let of = |s: &str| directions_said_of_map(&m, s, m.start_pose);
+        let of = |s: &str| said_of_map(&m, s, m.start_pose, SaidOf::Direction);
         // Held-out v8 (dev) hr04 and ht04, on flat-a's names.
         assert_eq!(
             of("the penultimate chair first. Next the 2nd table counting from the west"),
@@ -3183,6 +3229,38 @@ pub(crate) mod tests {
         // No direction said: none; a direction of no object anywhere: no narrowing.
         assert_eq!(of("the third chair, then the sofa"), None);
         assert_eq!(of("turn left"), None);
+    }
+
+    #[test]
+    fn a_count_is_said_of_the_objects_of_its_clause() {
+        let m = map();
+        let of = |s: &str| said_of_map(&m, s, m.start_pose, SaidOf::Count);
+        // Held-out v8 (dev) ht12, on flat-a's names.
+        assert_eq!(
+            of("fridge, red sofa, 2nd chair from the west, kitchen"),
+            Some(vec!["chair".to_string()])
+        );
+        assert_eq!(
+            of("the penultimate sofa, then table number 3"),
+            Some(vec!["sofa".to_string(), "table".to_string()])
+        );
+        // "First" and "last" place no count; nor does no count at all.
+        assert_eq!(of("the first chair, then the last sofa"), None);
+        let says = "but the person said a count only of the chair";
+        let f = findings(
+            "the red sofa, then the 2nd chair from the west",
+            "objects: [(sofa, None, red), (chair, 2, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{ordinal: 2, colour: \"red\"}));\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, order: \"west_to_east\"}));",
+        );
+        assert!(
+            f.iter().any(|x| x.to_model.contains(says)
+                && x.to_model.contains("picks the sofa with ordinal 2")),
+            "{f:?}"
+        );
+        assert!(
+            f.iter()
+                .all(|x| !x.to_model.contains("picks the chair with")),
+            "{f:?}"
+        );
     }
 
     #[test]

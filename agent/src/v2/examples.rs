@@ -288,7 +288,7 @@ mod tests {
             let unsaid =
                 super::super::check::unsaid_exclusions(&e.instruction, &[], in_chat, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
-            // A direction counts only the objects of the clause that says it; with no
+            // A direction or a count says only of the objects of its clause; with no
             // map, a name is the last word of a name the plan picks.
             let single = |n: &str| map_core::matcher::singular(&map_core::matcher::normalise(n));
             let last = |n: &str| n.split(' ').next_back().map(single);
@@ -299,13 +299,19 @@ mod tests {
                 .flat_map(|s| s.targets())
                 .filter_map(|t| last(&t.name))
                 .collect();
-            let said = super::super::check::directions_said_of(&e.instruction, |w, j| {
+            let name_at = |w: &[String], j: usize| {
                 let n = single(&w[j]);
                 picked.contains(&n).then_some((n, 1))
-            });
-            let elsewhere =
-                super::super::check::directions_said_of_others(said.as_deref(), &a.plan, last);
-            assert!(elsewhere.is_empty(), "line {}: {elsewhere:?}", e.line);
+            };
+            for what in [
+                super::super::check::SaidOf::Direction,
+                super::super::check::SaidOf::Count,
+            ] {
+                let said = super::super::check::said_of(&e.instruction, what, name_at);
+                let elsewhere =
+                    super::super::check::said_of_others(said.as_deref(), what, &a.plan, last);
+                assert!(elsewhere.is_empty(), "line {}: {elsewhere:?}", e.line);
+            }
             let from_end = super::super::check::counted_from_the_end(&a.plan);
             assert!(from_end.is_empty(), "line {}: {from_end:?}", e.line);
             // An example asked to come back moves back (the grammar then requires it).
