@@ -2238,9 +2238,8 @@ fn check_anchor_stops(
 
 /// Picks near an object the person never named, by a name or a synonym of it or a typo
 /// of one ("the cabinet nearest to you" as the cabinet `near: get_obj("workbench")`:
-/// held-out v7, dev, hq13, a wrong plan no check saw), or named only later as a stop of
-/// its own ([`named_later_as_a_stop`]). Outside a conversation, where an earlier
-/// instruction may have named it.
+/// held-out v7, dev, hq13, a wrong plan no check saw). Outside a conversation, where an
+/// earlier instruction may have named it.
 fn check_unsaid_anchors(
     map: &IvlMap,
     instruction: &str,
@@ -2255,16 +2254,6 @@ fn check_unsaid_anchors(
                 .or_else(|| typed_label_at(map, &w, k).map(|(_, l)| l))
         })
         .collect();
-    let clause_labels: Vec<Vec<String>> = clauses(instruction)
-        .iter()
-        .map(|c| {
-            object_mentions(map, c, pose)
-                .into_iter()
-                .map(|(_, l)| l)
-                .collect()
-        })
-        .collect();
-    let (stops, _) = stops_and_anchors(map, plan, pose);
     let mut out: Vec<Finding> = Vec::new();
     for t in targets(plan) {
         let Some(Object::Pick(a)) = t.near.as_deref() else {
@@ -2276,52 +2265,19 @@ fn check_unsaid_anchors(
         ) else {
             continue;
         };
-        let f = if !said.contains(&anchor) {
-            Finding::new(
-                FindingKind::Word,
-                format!("the plan picks the {label} near a {anchor}, but the person named no {anchor}: give near only an object the person named (with no near, distances are from the robot)"),
-                format!("which {label} do you mean? there are {}", describe_label(map, &label)),
-            )
-        } else if named_later_as_a_stop(&clause_labels, &stops, &label, &anchor) {
-            Finding::new(
-                FindingKind::Word,
-                format!("the plan picks the {label} near the {anchor}, but the person named the {anchor} once, later, as a stop of its own: pick the {label} as their words about it say (with no near, distances are from the robot)"),
-                format!("which {label} do you mean? there are {}", describe_label(map, &label)),
-            )
-        } else {
+        if said.contains(&anchor) {
             continue;
-        };
+        }
+        let f = Finding::new(
+            FindingKind::Word,
+            format!("the plan picks the {label} near a {anchor}, but the person named no {anchor}: give near only an object the person named (with no near, distances are from the robot)"),
+            format!("which {label} do you mean? there are {}", describe_label(map, &label)),
+        );
         if !out.contains(&f) {
             out.push(f);
         }
     }
     out
-}
-
-/// Whether `anchor` is named once, in a clause after every clause that names `label`
-/// (`clause_labels`: the labels each clause names, in order), and the plan also stops at
-/// it (`stops`): "whichever mirror is nearest you, then stop on the left of the green
-/// stool" (held-out v8, dev since its third run, ht14: the mirror picked near the stool,
-/// a wrong plan no check saw). "The chair, the one closest to the sofa" picks near the
-/// sofa too, but no plan that reads it so stops at the sofa.
-fn named_later_as_a_stop(
-    clause_labels: &[Vec<String>],
-    stops: &[String],
-    label: &str,
-    anchor: &str,
-) -> bool {
-    let at = |l: &str| -> Vec<usize> {
-        clause_labels
-            .iter()
-            .enumerate()
-            .flat_map(|(i, ls)| ls.iter().filter(|x| *x == l).map(move |_| i))
-            .collect()
-    };
-    let (at_anchor, at_label) = (at(anchor), at(label));
-    match (at_anchor.as_slice(), at_label.last()) {
-        ([a], Some(l)) => a > l && stops.iter().any(|s| s == anchor),
-        _ => false,
-    }
 }
 
 /// Everything found in `plan` and `tuples` for `instruction` on `map`. `visited` holds
@@ -3312,37 +3268,6 @@ pub(crate) mod tests {
             let f = findings(said, &pick("sofa"));
             assert!(
                 f.iter().all(|x| !x.to_model.contains("named no sofa")),
-                "{said}: {f:?}"
-            );
-        }
-        // Named once, later, as a stop of its own (held-out v8, dev, ht14).
-        let later = "as a stop of its own";
-        let stop_too = format!("{}\nmove_to_left(get_obj(\"sofa\"));", pick("sofa"));
-        let f = findings(
-            "go to the chair nearest to you, then stop on the left of the sofa",
-            &stop_too,
-        );
-        assert!(
-            f.iter()
-                .any(|x| x.to_model.contains("picks the chair near the sofa")
-                    && x.to_model.contains(later)),
-            "{f:?}"
-        );
-        // Not a stop, said in the same clause, or named before the chair: no finding.
-        for (said, answer) in [
-            ("go to the chair, the one closest to the sofa", pick("sofa")),
-            (
-                "go to the chair closest to the sofa, then the left of the sofa",
-                stop_too.clone(),
-            ),
-            (
-                "stop on the left of the sofa, then the chair nearest it",
-                stop_too.clone(),
-            ),
-        ] {
-            let f = findings(said, &answer);
-            assert!(
-                f.iter().all(|x| !x.to_model.contains(later)),
                 "{said}: {f:?}"
             );
         }
