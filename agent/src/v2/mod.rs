@@ -85,16 +85,7 @@ pub fn extract(
     );
     req.stop = vec!["\n".into()];
     if options.answer_grammar {
-        let mut vocab = Vocabulary {
-            said_words: words_said(instruction),
-            ..Vocabulary::default()
-        };
-        if options.said_tuple_colours {
-            vocab.tuple_colours = Some(said_tuple_colours(&vocab, instruction, &[]));
-        }
-        if options.said_only {
-            narrow_orders(&mut vocab, instruction);
-        }
+        let vocab = extract_vocabulary(instruction, options);
         req.grammar = Some(objects_grammar(&vocab));
         if options.llguidance {
             req.lark = Some(objects_lark(&vocab));
@@ -110,6 +101,27 @@ pub fn extract(
     })?;
     timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
     Ok((tuples, timing))
+}
+
+/// The objects line's vocabulary for [`extract`] (no map): the said words, the said
+/// colours and, with `said_only`, the ordinals and orders the person said, as a plan's
+/// first answer has them ([`said_ordinals`], [`narrow_orders`]). Until stop 65 the
+/// ordinals were not narrowed here, so "the cabinet furthest south" (counted from the
+/// south, `only_sides_counted_from_the_end`) was still offered "last": held-out v7
+/// (dev) hw07 listed `(cabinet, last, None, south_to_north)`.
+fn extract_vocabulary(instruction: &str, options: &crate::PlanOptions) -> Vocabulary {
+    let mut vocab = Vocabulary {
+        said_words: words_said(instruction),
+        ..Vocabulary::default()
+    };
+    if options.said_tuple_colours {
+        vocab.tuple_colours = Some(said_tuple_colours(&vocab, instruction, &[]));
+    }
+    if options.said_only {
+        vocab.ordinals = Some(said_ordinals(instruction));
+        narrow_orders(&mut vocab, instruction);
+    }
+    vocab
 }
 
 /// Whether the worked examples quote the person's words in a comment line above the calls
@@ -226,14 +238,7 @@ fn settle(findings: &[Finding]) -> Outcome {
 /// ([`Vocabulary::map_colours`], `PlanOptions::map_colours`): a pick selects only on
 /// its objects' colours.
 fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>) {
-    let counts = check::counts_said(instruction);
-    let from_start = check::only_sides_counted_from_the_end(instruction);
-    v.ordinals = Some(
-        (1..=20)
-            .flat_map(|k| [k, -k])
-            .filter(|&k| check::ordinal_said(&counts, k) && (k > 0 || !from_start))
-            .collect(),
-    );
+    v.ordinals = Some(said_ordinals(instruction));
     if ctx.references.is_empty() {
         if ctx.options.said_colours {
             v.colours_of = Some(colours_said_of(ctx.map, instruction));
@@ -326,6 +331,19 @@ fn narrow_exclusions(v: &mut Vocabulary, instruction: &str, known: &[String]) {
     for (_, pair) in v.pairs_of.iter_mut().flatten() {
         keep(&mut pair.not_colours);
     }
+}
+
+/// The ordinals a selection, and (as their sizes) a tuple of the objects line, may
+/// count: 1 and -1, and k and -k for each count k the person said
+/// ([`check::ordinal_said`]); no count from the end where the only one said is
+/// "furthest" + a side ([`check::only_sides_counted_from_the_end`]).
+fn said_ordinals(instruction: &str) -> Vec<i64> {
+    let counts = check::counts_said(instruction);
+    let from_start = check::only_sides_counted_from_the_end(instruction);
+    (1..=20)
+        .flat_map(|k| [k, -k])
+        .filter(|&k| check::ordinal_said(&counts, k) && (k > 0 || !from_start))
+        .collect()
 }
 
 /// Offers directional orders only when `instruction` names a direction, orders by size
@@ -818,6 +836,38 @@ mod tests {
 
     fn tuples(line: &str) -> Vec<Tuple> {
         parse_tuples(line).unwrap()
+    }
+
+    #[test]
+    fn extraction_offers_the_counts_a_first_answer_would() {
+        let options = crate::PlanOptions::default();
+        let accepts = |instruction: &str, line: &str| {
+            let lark = objects_lark(&extract_vocabulary(instruction, &options));
+            grammar::tests::lark_accepts(&lark, &format!("objects: [{line}]\n")).is_ok()
+        };
+        // "furthest" + a side counts from that side: no "last" (held-out v7, dev, hw07).
+        let south = "the cabinet furthest south, and after that the office";
+        assert!(accepts(
+            south,
+            "(cabinet, 1, None, south_to_north), (office, None, None)"
+        ));
+        assert!(!accepts(
+            south,
+            "(cabinet, last, None, south_to_north), (office, None, None)"
+        ));
+        // The far end said: "last" stays on offer.
+        assert!(accepts(
+            "the bench farthest from you",
+            "(bench, last, None)"
+        ));
+        // Not narrowed without `said_only`.
+        let open = crate::PlanOptions {
+            said_only: false,
+            ..crate::PlanOptions::default()
+        };
+        let lark = objects_lark(&extract_vocabulary(south, &open));
+        let line = "objects: [(cabinet, last, None, south_to_north)]\n";
+        assert!(grammar::tests::lark_accepts(&lark, line).is_ok());
     }
 
     #[test]
