@@ -333,10 +333,10 @@ fn narrow_exclusions(v: &mut Vocabulary, instruction: &str, known: &[String]) {
     }
 }
 
-/// The ordinals a selection, and (as their sizes) a tuple of the objects line, may
-/// count: 1 and -1, and k and -k for each count k the person said
-/// ([`check::ordinal_said`]); no count from the end where the only one said is
-/// "furthest" + a side ([`check::only_sides_counted_from_the_end`]).
+/// The ordinals a selection may count: 1 and -1, and k and -k for each count k the
+/// person said ([`check::ordinal_said`]); no count from the end where the only one said
+/// is "furthest" + a side ([`check::only_sides_counted_from_the_end`]). The objects line
+/// reads only their signs: "last" where a count from the end is offered.
 fn said_ordinals(instruction: &str) -> Vec<i64> {
     let counts = check::counts_said(instruction);
     let from_start = check::only_sides_counted_from_the_end(instruction);
