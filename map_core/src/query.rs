@@ -123,6 +123,17 @@ impl ObjectOrder {
         })
     }
 
+    /// The sides the directional orders count from ("left", "right", "north", ...), in
+    /// [`ObjectOrder::ALL`]'s order: the first word of each directional order's name, so
+    /// [`ObjectOrder::starting_at`] takes each of them. A side is where a count starts,
+    /// never an object ("the speaker furthest east" names no object "east").
+    pub fn sides() -> impl Iterator<Item = &'static str> {
+        ObjectOrder::ALL
+            .iter()
+            .filter(|(o, _)| o.is_directional())
+            .filter_map(|(_, n)| n.split("_to_").next())
+    }
+
     /// The order's snake_case name, e.g. `near_to_far`.
     pub fn name(self) -> &'static str {
         ObjectOrder::ALL
@@ -492,6 +503,12 @@ mod tests {
             assert_eq!(o.name(), name);
             assert!(o.is_directional());
             assert!(o.reversed().name().ends_with(side), "{side}");
+        }
+        // The sides are exactly the words an order starts at, each once.
+        let sides: Vec<&str> = ObjectOrder::sides().collect();
+        assert_eq!(sides, ["left", "right", "north", "south", "west", "east"]);
+        for side in sides {
+            assert!(ObjectOrder::starting_at(side).is_some(), "{side}");
         }
         for not_a_side in ["", "up", "North", "near", "largest"] {
             assert_eq!(ObjectOrder::starting_at(not_a_side), None, "{not_a_side}");

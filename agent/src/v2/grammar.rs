@@ -500,15 +500,29 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
             let mut words: Vec<String> = colours.iter().map(|c| regex_escape(c)).collect();
             words.sort();
             words.dedup();
+            // A side a count starts at ("east", [`ObjectOrder::sides`]) is never a whole
+            // object either: held-out v8 (dev) hx39, "the black speaker furthest east",
+            // was listed `(speaker, None, black), (east, None, None)`, and with only the
+            // side word barred, `(eastmost, None, None)`. So one word that begins with a
+            // side is barred; "west wing" or "east wall" may name a room or a thing.
+            let sides: Vec<&str> = ObjectOrder::sides().collect();
             w.rule(
                 "TWORD",
-                &format!("{tword} & ~/(.* )?({})[a-z-]*( .*)?/", words.join("|")),
+                &format!(
+                    "{tword} & ~/(.* )?({})[a-z-]*( .*)?/ & ~/({})[a-z-]*/",
+                    words.join("|"),
+                    sides.join("|")
+                ),
             );
             let begins_with_colour = |x: &str| colours.iter().any(|c| x.starts_with(c.as_str()));
             let is_colour = |x: &str| colours.iter().any(|c| c == x);
+            // A map's own name that begins with a colour, or one word that begins with a
+            // side, stays allowed.
+            let begins_with_side =
+                |x: &str| !x.contains(' ') && sides.iter().any(|s| x.starts_with(s));
             let mut coloured: Vec<&String> = map_names
                 .iter()
-                .filter(|n| n.split_whitespace().any(begins_with_colour))
+                .filter(|n| n.split_whitespace().any(begins_with_colour) || begins_with_side(n))
                 .collect();
             // A word the person said, not a colour word itself.
             for w in &vocab.said_words {
@@ -1850,6 +1864,8 @@ pub(crate) mod tests {
         let mut v = vocab();
         v.regions.push("red room".into());
         v.names.push("whiteboard".into());
+        // A map's own one-word name may begin with a side.
+        v.names.push("leftovers".into());
         let lark = answer_lark(&v);
         let plan = "\nplan:\nmove_to_object(get_obj(\"chair\"));";
         for ok in [
@@ -1858,6 +1874,8 @@ pub(crate) mod tests {
             "(tabel, None, None)",
             "(red room, None, None)",
             "(whiteboard, None, None)",
+            "(leftovers, None, None)",
+            "(west wing, None, None)",
         ] {
             let answer = format!("objects: [{ok}]{plan}");
             lark_accepts(&lark, &answer).unwrap_or_else(|e| panic!("{ok}: {e}"));
@@ -1873,6 +1891,9 @@ pub(crate) mod tests {
             "(yellowone, None, yellow)",
             "(chair whitecounter, None, None)",
             "(redwood desk, None, None)",
+            // A side is no object.
+            "(east, None, None)",
+            "(northmost, None, None)",
         ] {
             let answer = format!("objects: [(sofa, None, None), {bad}]{plan}");
             assert!(lark_accepts(&lark, &answer).is_err(), "{bad}");
@@ -1895,6 +1916,22 @@ pub(crate) mod tests {
             "(whiteboard, None, None)",
         ] {
             assert!(lark_accepts(&only, &line(bad)).is_err(), "{bad}");
+        }
+        // A side is no object (held-out v8 hx39, "the black speaker furthest east"); a
+        // name with a side in it is.
+        let v = Vocabulary {
+            said_words: words_said("umm the black speaker furthest east, then back here"),
+            ..Vocabulary::default()
+        };
+        let only = objects_lark(&v);
+        for ok in ["(speaker, None, black)", "(east wing, None, None)"] {
+            lark_accepts(&only, &line(ok)).unwrap_or_else(|e| panic!("{ok}: {e}"));
+        }
+        for side in ObjectOrder::sides() {
+            for word in [side.to_string(), format!("{side}most")] {
+                let bad = format!("(speaker, None, black), ({word}, None, None)");
+                assert!(lark_accepts(&only, &line(&bad)).is_err(), "{bad}");
+            }
         }
     }
 
