@@ -110,6 +110,10 @@ pub struct PlanOptions {
     /// end) only where the person said a count of its object, in the clause naming it
     /// (default on; `--counts-anywhere` turns it off).
     pub counts_of_said: bool,
+    /// With `said_only`, outside a conversation: `move_between_the_two` may name only
+    /// an object the person said in the plural ("between the two red stools"; default
+    /// on; `--pairs-anywhere` turns it off).
+    pub pairs_of_said: bool,
     /// The objects line's colours are the person's (default on; `--any-tuple-colours`
     /// turns it off).
     pub said_tuple_colours: bool,
@@ -164,6 +168,7 @@ impl Default for PlanOptions {
             said_exclusions: true,
             directions_of_said: true,
             counts_of_said: true,
+            pairs_of_said: true,
             said_tuple_colours: true,
             map_colours: true,
             redraws: 1,

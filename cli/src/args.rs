@@ -284,6 +284,10 @@ pub(crate) struct ModelArgs {
     /// comparison).
     #[arg(long)]
     pub(crate) counts_anywhere: bool,
+    /// Let `move_between_the_two` name any object with two or more on the map, not only
+    /// one the person said in the plural (the default before stop 66; for comparison).
+    #[arg(long)]
+    pub(crate) pairs_anywhere: bool,
     /// Let a tuple on the objects line carry any colour word, not only a colour the
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
@@ -357,6 +361,7 @@ impl ModelArgs {
             said_exclusions: !self.any_not_colours,
             directions_of_said: !self.directions_anywhere,
             counts_of_said: !self.counts_anywhere,
+            pairs_of_said: !self.pairs_anywhere,
             said_tuple_colours: !self.any_tuple_colours,
             map_colours: !self.any_pick_colours,
             redraws: self.redraws,

@@ -1594,6 +1594,49 @@ pub(crate) fn between_said(instruction: &str) -> bool {
         .any(|w| matches!(w.as_str(), "between" | "inbetween"))
 }
 
+/// The names of `names` the person said in the plural ("between the two red stools",
+/// "go between the chairs"): the plural of the whole name
+/// ([`map_core::matcher::plural`]: "costume racks", "shelves") as consecutive words of
+/// `instruction`. "Between the piano and the black microphone" says no name in the
+/// plural: it is a stop between two objects of two names, not "the two microphones".
+pub(crate) fn said_in_plural<'a>(names: &'a [String], instruction: &str) -> Vec<&'a String> {
+    let w = words(instruction);
+    names
+        .iter()
+        .filter(|n| {
+            let p = words(&map_core::matcher::plural(&n.to_lowercase()));
+            !p.is_empty() && w.windows(p.len()).any(|x| x == p.as_slice())
+        })
+        .collect()
+}
+
+/// A finding for each `move_between_the_two` of a name the person did not say in the
+/// plural under any of its names ([`said_in_plural`]): "between the piano and the
+/// black microphone" is a stop between two objects, not "the two microphones". The
+/// check of the first answer's narrowing (`v2::narrow_pairs`), for a backend that takes
+/// no grammar.
+fn pairs_unsaid(map: &IvlMap, instruction: &str, plan: &TypedPlan, pose: Pose) -> Vec<Finding> {
+    plan.steps
+        .iter()
+        .filter_map(|s| match s {
+            Step::BetweenTwo(t) => Some(t),
+            _ => None,
+        })
+        .filter(|t| {
+            let names = object_label(map, &t.name, pose)
+                .map_or_else(|| vec![t.name.clone()], crate::v2::grammar::label_names);
+            said_in_plural(&names, instruction).is_empty()
+        })
+        .map(|t| {
+            Finding::new(
+                FindingKind::Word,
+                format!("the plan stops between the two {}, but the person did not say \"the two {}\": for a stop between two objects the person names, write move_in_between(a, b) with a pick of each", map_core::matcher::plural(&t.name), map_core::matcher::plural(&t.name)),
+                "between which two objects shall I stop?",
+            )
+        })
+        .collect()
+}
+
 /// Whether `plan` stops between two objects (`move_in_between`, `move_between_the_two`).
 /// Held-out v3 (dev) hg11: "stop between the bench and the white shelf" planned as the
 /// bench nearest the shelf passed every check.
@@ -2342,6 +2385,9 @@ pub fn check_answer_after(
             "between what shall I stop?",
         ));
     }
+    if refs.is_empty() && earlier.is_none() {
+        out.extend(pairs_unsaid(map, instruction, plan, pose));
+    }
     let known = known_colours(map, refs, earlier);
     let allowed = said_before(instruction, earlier);
     out.extend(check_unsaid_colours(map, &allowed, &known, plan, pose));
@@ -2483,6 +2529,49 @@ pub(crate) mod tests {
             "/../examples/scenes/flat-a.scene.json"
         );
         IvlMap::from_scene(&map_core::scene::Scene::from_path(path).unwrap())
+    }
+
+    #[test]
+    fn the_two_of_a_name_said_only_once_is_found() {
+        let pair = |f: &[Finding]| f.iter().any(|x| x.to_model.contains("the two sofas"));
+        // Two objects named, one of them a sofa: a stop between two objects.
+        let f = findings(
+            "stop between the red sofa and the black table",
+            "objects: [(sofa, None, red), (table, None, black)]\nplan:\nmove_between_the_two(\"sofa\");",
+        );
+        assert!(pair(&f), "{f:?}");
+        assert!(f
+            .iter()
+            .any(|x| x.to_user == "between which two objects shall I stop?"));
+        // "The two sofas", or "couches" for them: the pair.
+        for said in ["stop between the two sofas", "stop between the couches"] {
+            let f = findings(
+                said,
+                "objects: [(sofa, None, None)]\nplan:\nmove_between_the_two(\"sofa\");",
+            );
+            assert!(!pair(&f), "{said}: {f:?}");
+        }
+    }
+
+    #[test]
+    fn names_said_in_the_plural() {
+        let names: Vec<String> = ["costume rack", "shelf", "chair", "rack", "piano"]
+            .iter()
+            .map(|s| (*s).to_string())
+            .collect();
+        let said = |i: &str| -> Vec<&str> {
+            said_in_plural(&names, i)
+                .into_iter()
+                .map(String::as_str)
+                .collect()
+        };
+        assert_eq!(
+            said("between the two Costume Racks"),
+            ["costume rack", "rack"]
+        );
+        assert_eq!(said("go between the shelves, then the chair"), ["shelf"]);
+        assert!(said("between the piano and the black microphone").is_empty());
+        assert!(said("the chair, then the costume rack").is_empty());
     }
 
     fn findings(instruction: &str, answer: &str) -> Vec<Finding> {
