@@ -1628,9 +1628,10 @@ fn pairs_unsaid(map: &IvlMap, instruction: &str, plan: &TypedPlan, pose: Pose) -
             said_in_plural(&names, instruction).is_empty()
         })
         .map(|t| {
+            let two = map_core::matcher::plural(&t.name);
             Finding::new(
                 FindingKind::Word,
-                format!("the plan stops between the two {}, but the person did not say \"the two {}\": for a stop between two objects the person names, write move_in_between(a, b) with a pick of each", map_core::matcher::plural(&t.name), map_core::matcher::plural(&t.name)),
+                format!("the plan stops between the two {two}, but the person did not say \"the two {two}\": for a stop between two objects the person names, write move_in_between(a, b) with a pick of each"),
                 "between which two objects shall I stop?",
             )
         })
