@@ -114,6 +114,11 @@ pub struct PlanOptions {
     /// an object the person said in the plural ("between the two red stools"; default
     /// on; `--pairs-anywhere` turns it off).
     pub pairs_of_said: bool,
+    /// With `said_only`: a pick may count only in the directional orders the person's
+    /// words count in (`check::directions_said`: "the second to last seat from the
+    /// west" in `east_to_west`, "the westernmost shelf" in `west_to_east`), where every
+    /// word naming a direction is read so (default on; `--any-direction` turns it off).
+    pub orders_of_said: bool,
     /// The objects line's colours are the person's (default on; `--any-tuple-colours`
     /// turns it off).
     pub said_tuple_colours: bool,
@@ -169,6 +174,7 @@ impl Default for PlanOptions {
             directions_of_said: true,
             counts_of_said: true,
             pairs_of_said: true,
+            orders_of_said: true,
             said_tuple_colours: true,
             map_colours: true,
             redraws: 1,

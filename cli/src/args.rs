@@ -288,6 +288,11 @@ pub(crate) struct ModelArgs {
     /// one the person said in the plural (the default before stop 66; for comparison).
     #[arg(long)]
     pub(crate) pairs_anywhere: bool,
+    /// Let a pick count in any directional order wherever the instruction names a
+    /// direction, not only the orders its words count in ("the second to last seat from
+    /// the west" in `east_to_west`; the default before stop 67; for comparison).
+    #[arg(long)]
+    pub(crate) any_direction: bool,
     /// Let a tuple on the objects line carry any colour word, not only a colour the
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
@@ -362,6 +367,7 @@ impl ModelArgs {
             directions_of_said: !self.directions_anywhere,
             counts_of_said: !self.counts_anywhere,
             pairs_of_said: !self.pairs_anywhere,
+            orders_of_said: !self.any_direction,
             said_tuple_colours: !self.any_tuple_colours,
             map_colours: !self.any_pick_colours,
             redraws: self.redraws,

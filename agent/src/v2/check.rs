@@ -924,6 +924,63 @@ fn counts_from_the_end(word: &str) -> bool {
 /// Whether some target of the plan passes a test.
 type AnyTarget<'a> = dyn Fn(&dyn Fn(&Target) -> bool) -> bool + 'a;
 
+/// A count said from a side, as [`side_count`] reads it.
+struct SideCount {
+    /// The order it counts in: starting at the side, or at the other side where a count
+    /// from the end is said.
+    order: ObjectOrder,
+    /// The count (1 where none is written: "the last ... from the west").
+    k: i64,
+    /// Whether a count from the end is said ("last", "to last", "penultimate").
+    from_the_end: bool,
+    /// The words that say it.
+    span: std::ops::Range<usize>,
+}
+
+/// The count said from a side at `w[at]` ("from"; [`counted_from_a_side`]): `None`
+/// where no side follows "from the", or no count is said within [`FROM_WORDS`] words
+/// before it (or after it, after "counting").
+fn side_count(w: &[String], at: usize) -> Option<SideCount> {
+    let (Some("the"), Some(side)) = (w.get(at + 1).map(String::as_str), w.get(at + 2)) else {
+        return None;
+    };
+    let start = ObjectOrder::starting_at(side)?;
+    let is_count = |x: &String| counts_from_the_end(x) || said_count(x).is_some();
+    let before = at.saturating_sub(FROM_WORDS)..at;
+    let counting = at > 0 && w[at - 1].starts_with("count");
+    let span = match w[before.clone()].iter().position(is_count) {
+        Some(p) => before.start + p..at + 3,
+        None if counting => {
+            let p = w
+                .iter()
+                .skip(at + 3)
+                .take(FROM_WORDS + 1)
+                .position(is_count)?;
+            at - 1..at + 4 + p
+        }
+        None => return None,
+    };
+    let said = &w[span.clone()];
+    let from_the_end = said.iter().any(|x| counts_from_the_end(x));
+    let k = said
+        .iter()
+        .filter_map(|x| said_count(x))
+        .map(i64::abs)
+        .find(|&k| k > 1)
+        .unwrap_or(1);
+    let order = if from_the_end {
+        start.reversed()
+    } else {
+        start
+    };
+    Some(SideCount {
+        order,
+        k,
+        from_the_end,
+        span,
+    })
+}
+
 /// A count said from a side (`w[at]` is "from"): "the second plant from the west" is
 /// ordinal 2 in `west_to_east`, and "the second to last plant from the west" ordinal 2
 /// in `east_to_west` (design.md). The count is said within [`FROM_WORDS`] words before
@@ -932,42 +989,18 @@ type AnyTarget<'a> = dyn Fn(&dyn Fn(&Target) -> bool) -> bool + 'a;
 /// object). Held-out v3 (dev): "the second red chair counting from the west" was
 /// counted from the east and no check saw it.
 fn counted_from_a_side(w: &[String], at: usize, any_target: &AnyTarget<'_>) -> Vec<Finding> {
-    let (Some("the"), Some(side)) = (w.get(at + 1).map(String::as_str), w.get(at + 2)) else {
+    let Some(SideCount {
+        order: o, k, span, ..
+    }) = side_count(w, at)
+    else {
         return Vec::new();
     };
-    let Some(start) = ObjectOrder::starting_at(side) else {
-        return Vec::new();
-    };
-    let is_count = |x: &String| counts_from_the_end(x) || said_count(x).is_some();
-    let before = at.saturating_sub(FROM_WORDS)..at;
-    let counting = at > 0 && w[at - 1].starts_with("count");
-    let span = match w[before.clone()].iter().position(is_count) {
-        Some(p) => before.start + p..at + 3,
-        None if counting => match w
-            .iter()
-            .skip(at + 3)
-            .take(FROM_WORDS + 1)
-            .position(is_count)
-        {
-            Some(p) => at - 1..at + 4 + p,
-            None => return Vec::new(),
-        },
-        None => return Vec::new(),
-    };
-    let words = &w[span];
-    let reversed = words.iter().any(|x| counts_from_the_end(x));
-    let k = words
-        .iter()
-        .filter_map(|x| said_count(x))
-        .map(i64::abs)
-        .find(|&k| k > 1)
-        .unwrap_or(1);
-    let o = if reversed { start.reversed() } else { start };
     // An unwritten ordinal is the first (map_core), so it counts only "the first ...
     // from the east" (held-out v7, dev, hq14: `#{order: "east_to_west"}` was re-asked).
     if any_target(&|t| (t.ordinal != 0 || k == 1) && from_end(t, o)) {
         return Vec::new();
     }
+    let words = &w[span];
     let said = words.join(" ");
     vec![Finding::new(
         FindingKind::Word,
@@ -1742,6 +1775,63 @@ pub(crate) fn unsaid_sizes<'a>(instruction: &str, plan: &'a TypedPlan) -> Vec<&'
 /// directional order needs.
 pub(crate) fn direction_said(instruction: &str) -> bool {
     starts_a_word(instruction, DIRECTION_STEMS)
+}
+
+/// The directional orders `instruction` counts in, as the checks read them: a count
+/// from a side ([`side_count`]: "the second seat from the west" in `west_to_east`, "the
+/// second to last seat from the west" in `east_to_west`, "the last seat from the west"
+/// in either, as -1 or as 1 from the other end), a directional superlative ("the
+/// westernmost shelf": `west_to_east`) and "furthest" + a side ([`side_after`]: "the
+/// shelf furthest east": `east_to_west`). A side of a side move ("the north side of the
+/// table", "left of the sofa") counts in none. `None` where some word naming a direction
+/// ([`names_a_direction`]) is read by none of these ("on your left", "north-east"):
+/// then nothing narrows.
+///
+/// Held-out v8 (hr09) and v9 (hu09, hv09), dev since their third runs: the default
+/// model wrote "the second to last X from the west" as `ordinal: 2, order:
+/// "west_to_east"` (the second from the west), in the first answer and in every
+/// re-ask, though a worked example writes it `ordinal: 2, order: "east_to_west"`; all
+/// three ended in questions.
+pub(crate) fn directions_said(instruction: &str) -> Option<Vec<ObjectOrder>> {
+    let w = words(instruction);
+    let mut out: Vec<ObjectOrder> = Vec::new();
+    let mut read = vec![false; w.len()];
+    for (i, x) in w.iter().enumerate() {
+        let mut found: Vec<ObjectOrder> = Vec::new();
+        if x == "from" {
+            if let Some(c) = side_count(&w, i) {
+                read[i + 2] = true;
+                found.push(c.order);
+                if c.from_the_end && c.k == 1 {
+                    found.push(c.order.reversed());
+                }
+            }
+        } else if matches!(x.as_str(), "furthest" | "farthest") {
+            if let Some((j, o)) = side_after(&w, i) {
+                read[j] = true;
+                found.push(o);
+            }
+        } else if let Ok((Some(1), Some(order))) = parse_ordinal_with_order(x) {
+            if let Ok(o) = ObjectOrder::parse(&order) {
+                read[i] = true;
+                found.push(o);
+            }
+        }
+        for o in found {
+            if !out.contains(&o) {
+                out.push(o);
+            }
+        }
+    }
+    let side_move = |i: usize| {
+        ObjectOrder::starting_at(&w[i]).is_some()
+            && matches!(
+                w.get(i + 1).map(String::as_str),
+                Some("of" | "side" | "hand")
+            )
+    };
+    let unread = (0..w.len()).any(|i| names_a_direction(&w[i]) && !read[i] && !side_move(i));
+    (!unread).then_some(out)
 }
 
 /// The starts of words that name a side or a compass direction ([`direction_said`]).
@@ -3430,6 +3520,48 @@ pub(crate) mod tests {
             "objects: [(plant, None, None), (tv, None, None)]\nplan:\nmove_to_object(get_obj(\"plant\", #{near: get_obj(\"tv\")}));",
         );
         assert!(f.is_empty(), "{f:?}");
+    }
+
+    #[test]
+    fn the_directions_said_are_the_orders_the_words_count_in() {
+        use ObjectOrder::*;
+        let said = |s: &str| directions_said(s);
+        // A count from a side, from its start or, counted from the end, from the other.
+        assert_eq!(said("the 2nd seat from the west"), Some(vec![WestToEast]));
+        assert_eq!(
+            said("to do: 2nd to last teller desk from the west; a white table"),
+            Some(vec![EastToWest])
+        );
+        assert_eq!(
+            said("the penultimate lamp from the east"),
+            Some(vec![WestToEast])
+        );
+        assert_eq!(
+            said("counting from the north, the third bin"),
+            Some(vec![NorthToSouth])
+        );
+        // "The last ... from the west" is -1 from the west or 1 from the east.
+        assert_eq!(
+            said("the last seat counting from the west"),
+            Some(vec![EastToWest, WestToEast])
+        );
+        // Superlatives and "furthest" + a side.
+        assert_eq!(said("the westernmost shelf"), Some(vec![WestToEast]));
+        assert_eq!(
+            said("the speaker furthest to the east, then the leftmost chair"),
+            Some(vec![EastToWest, LeftToRight])
+        );
+        // A side move counts in no order; no direction, none.
+        assert_eq!(said("stop on the north side of the table"), Some(vec![]));
+        assert_eq!(
+            said("park left of the sofa, then the third chair from the right"),
+            Some(vec![RightToLeft])
+        );
+        assert_eq!(said("the third chair"), Some(vec![]));
+        // A direction no count reads: nothing to narrow.
+        assert_eq!(said("the chair on your left"), None);
+        assert_eq!(said("the north-east corner chair"), None);
+        assert_eq!(said("the chair from the west"), None);
     }
 
     #[test]

@@ -37,6 +37,10 @@ pub struct Vocabulary {
     pub ordinals: Option<Vec<i64>>,
     /// Offer only the orders that name no direction (nearest, farthest, size first).
     pub no_directions: bool,
+    /// The directional orders offered (`None`: every one, unless `no_directions`): the
+    /// orders the person's words count in
+    /// ([`check::directions_said`](super::check::directions_said)).
+    pub directions: Option<Vec<ObjectOrder>>,
     /// Offer no order by size (largest or smallest first).
     pub no_sizes: bool,
     /// Offer no `far_to_near` order (farthest first).
@@ -206,6 +210,7 @@ impl Vocabulary {
             ids: Vec::new(),
             ordinals: None,
             no_directions: false,
+            directions: None,
             no_sizes: false,
             no_far_end: false,
             directions_of: None,
@@ -396,6 +401,11 @@ fn offered_orders(vocab: &Vocabulary, with_default: bool) -> Vec<&'static str> {
         .into_iter()
         .filter(|o| {
             !vocab.no_directions || ObjectOrder::parse(o).is_ok_and(|o| !o.is_directional())
+        })
+        .filter(|o| {
+            vocab.directions.as_ref().is_none_or(|d| {
+                ObjectOrder::parse(o).is_ok_and(|o| !o.is_directional() || d.contains(&o))
+            })
         })
         .filter(|o| !vocab.no_sizes || ObjectOrder::parse(o).is_ok_and(|o| !o.is_by_size()))
         .filter(|o| !vocab.no_far_end || ObjectOrder::parse(o) != Ok(ObjectOrder::FarToNear))

@@ -120,6 +120,9 @@ fn extract_vocabulary(instruction: &str, options: &crate::PlanOptions) -> Vocabu
     if options.said_only {
         vocab.ordinals = Some(said_ordinals(instruction));
         narrow_orders(&mut vocab, instruction);
+        if options.orders_of_said {
+            vocab.directions = check::directions_said(instruction);
+        }
     }
     vocab
 }
@@ -260,6 +263,9 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
         }
     }
     narrow_orders(v, instruction);
+    if ctx.options.orders_of_said {
+        v.directions = check::directions_said(instruction);
+    }
 }
 
 /// Offers `move_between_the_two` only to the names the person said in the plural
@@ -1389,6 +1395,52 @@ mod tests {
         assert!(!narrowed("now the other chair", &[9])
             .not_colours_of
             .is_some_and(|g| g.iter().all(|(_, l)| l.is_empty())));
+    }
+
+    #[test]
+    fn a_pick_counts_only_in_the_directions_the_words_count_in() {
+        let said = "the second to last chair from the west, then the kitchen";
+        assert_eq!(
+            narrowed(said, &[]).directions,
+            Some(vec![map_core::ObjectOrder::EastToWest])
+        );
+        // The plan and the objects line count it from the east only.
+        grammar::tests::assert_offers(
+            &narrowed_grammar(said),
+            one_pick,
+            &[r#""chair", #{ordinal: 2, order: "east_to_west"}"#],
+            &[
+                r#""chair", #{ordinal: 2, order: "west_to_east"}"#,
+                r#""chair", #{ordinal: -2, order: "west_to_east"}"#,
+            ],
+        );
+        grammar::tests::assert_offers(
+            &narrowed_grammar(said),
+            |t| format!("objects: [{t}]\nplan:\nmove_to_object(get_obj(\"chair\"));"),
+            &["(chair, 2, None, east_to_west)"],
+            &["(chair, 2, None, west_to_east)"],
+        );
+        // A word of a direction read by no count ("on your left"): every direction.
+        assert_eq!(narrowed("the chair on your left", &[]).directions, None);
+        grammar::tests::assert_offers(
+            &narrowed_grammar("the westernmost chair, then the chair on your left"),
+            one_pick,
+            &[r#""chair", #{ordinal: 1, order: "east_to_west"}"#],
+            &[],
+        );
+        // In extraction too.
+        let options = crate::PlanOptions::default();
+        assert_eq!(
+            extract_vocabulary(said, &options).directions,
+            Some(vec![map_core::ObjectOrder::EastToWest])
+        );
+        // `--any-direction`.
+        let m = map();
+        let mut ctx = PlanContext::new(&m);
+        ctx.options.orders_of_said = false;
+        let mut v = Vocabulary::for_map(&m);
+        narrow_to_words(&mut v, said, &ctx);
+        assert_eq!(v.directions, None);
     }
 
     #[test]
