@@ -119,6 +119,10 @@ pub struct PlanOptions {
     /// west" in `east_to_west`, "the westernmost shelf" in `west_to_east`), where every
     /// word naming a direction is read so (default on; `--any-direction` turns it off).
     pub orders_of_said: bool,
+    /// With `said_only`, outside a conversation: a pick may be picked near (`near:`)
+    /// only an object the person named in a clause with it (`check::anchors_said`;
+    /// default on; `--anchors-anywhere` turns it off).
+    pub anchors_of_said: bool,
     /// The objects line's colours are the person's (default on; `--any-tuple-colours`
     /// turns it off).
     pub said_tuple_colours: bool,
@@ -175,6 +179,7 @@ impl Default for PlanOptions {
             counts_of_said: true,
             pairs_of_said: true,
             orders_of_said: true,
+            anchors_of_said: true,
             said_tuple_colours: true,
             map_colours: true,
             redraws: 1,

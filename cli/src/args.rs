@@ -293,6 +293,10 @@ pub(crate) struct ModelArgs {
     /// the west" in `east_to_west`; the default before stop 67; for comparison).
     #[arg(long)]
     pub(crate) any_direction: bool,
+    /// Let a pick be picked near any object, not only one the person named in a clause
+    /// with it (the default before stop 67; for comparison).
+    #[arg(long)]
+    pub(crate) anchors_anywhere: bool,
     /// Let a tuple on the objects line carry any colour word, not only a colour the
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
@@ -368,6 +372,7 @@ impl ModelArgs {
             counts_of_said: !self.counts_anywhere,
             pairs_of_said: !self.pairs_anywhere,
             orders_of_said: !self.any_direction,
+            anchors_of_said: !self.anchors_anywhere,
             said_tuple_colours: !self.any_tuple_colours,
             map_colours: !self.any_pick_colours,
             redraws: self.redraws,

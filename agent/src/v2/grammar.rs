@@ -54,6 +54,11 @@ pub struct Vocabulary {
     /// ([`check::said_of`](super::check::said_of)); the others
     /// count only 1 or -1.
     pub counts_of: Option<Vec<String>>,
+    /// The names a pick of each name may be picked near (`near:`), as groups of names
+    /// sharing one list (`None`: any name; a name in no group, or in a group with an
+    /// empty list, takes no `near:`): outside a conversation, the objects the person
+    /// named in a clause with it ([`check::anchors_said`](super::check::anchors_said)).
+    pub anchors_of: Option<Vec<(Vec<String>, Vec<String>)>>,
     /// Names whose picks must select on a colour (`colour:`, one of the name's colours
     /// in [`Vocabulary::colours_of`]): a re-ask after a said colour the plan dropped
     /// ([`check::Bar::ColourDropped`](super::check::Bar::ColourDropped)).
@@ -215,6 +220,7 @@ impl Vocabulary {
             no_far_end: false,
             directions_of: None,
             counts_of: None,
+            anchors_of: None,
             colour_required: Vec::new(),
             colour_key_required: Vec::new(),
             colours_of: None,
@@ -713,6 +719,9 @@ struct SelKeys<'a> {
     /// The suffix of the ordinal rules: `""` for `pint` and `nint`, `"1"` for 1 and -1
     /// alone ([`PickGroup::no_counts`]).
     ints: &'a str,
+    /// The rule of the objects `near:` may name (none: no such key): `objn`, or a
+    /// group's anchors ([`PickGroup::anchors`]).
+    near: Option<&'a str>,
 }
 
 impl SelKeys<'_> {
@@ -786,8 +795,10 @@ impl SelKeys<'_> {
                 out.push((format!("\"region: \" {r}"), after(KEY_REGION, s.pending)));
             }
         }
-        if open(KEY_NEAR) {
-            out.push(("\"near: \" objn".into(), after(KEY_NEAR, s.pending)));
+        if let Some(near) = self.near {
+            if open(KEY_NEAR) {
+                out.push((format!("\"near: \" {near}"), after(KEY_NEAR, s.pending)));
+            }
         }
         // A required colour key comes first, or right after the ordinal (the worked
         // examples' order). Measured on held-out v2 (dev): required anywhere, the default
@@ -833,7 +844,7 @@ fn selection_rules(
     w: &mut Writer,
     suffix: &str,
     (colour, not_colour): (Option<&str>, Option<&str>),
-    region: Option<&str>,
+    (region, near): (Option<&str>, Option<&str>),
     vocab: &Vocabulary,
     not_from_end: bool,
     (colour_required, colour_key_required, no_directions, no_counts): (bool, bool, bool, bool),
@@ -850,6 +861,7 @@ fn selection_rules(
         colour_key_required: colour_key_required && colour.is_some(),
         orders: if no_directions { "d" } else { "" },
         ints: if no_counts { "1" } else { "" },
+        near,
     };
     let name = |s: SelState| {
         let pending = match s.pending {
@@ -926,6 +938,9 @@ struct PickGroup {
     no_directions: bool,
     /// Its picks count only 1 or -1 ([`Vocabulary::counts_of`]).
     no_counts: bool,
+    /// The names its picks may be picked near (`None`: any; empty: no `near:`;
+    /// [`Vocabulary::anchors_of`]). Pair groups take any.
+    anchors: Option<Vec<String>>,
 }
 
 /// The list of the group holding `name` in `groups` ([`Vocabulary::colours_of`],
@@ -956,6 +971,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
         && vocab.colour_key_required.is_empty()
         && vocab.directions_of.is_none()
         && vocab.counts_of.is_none()
+        && vocab.anchors_of.is_none()
     {
         return None;
     }
@@ -997,6 +1013,10 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
             .as_ref()
             .is_some_and(|d| !d.contains(name));
         let no_counts = vocab.counts_of.as_ref().is_some_and(|d| !d.contains(name));
+        let anchors = match &vocab.anchors_of {
+            Some(a) if !pairs => Some(group_list(Some(a), name).unwrap_or_default()),
+            _ => None,
+        };
         match groups.iter_mut().find(|g| {
             g.colours == colours
                 && g.not_colours == not_colours
@@ -1005,6 +1025,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
                 && g.colour_key_required == colour_key_required
                 && g.no_directions == no_directions
                 && g.no_counts == no_counts
+                && g.anchors == anchors
         }) {
             Some(g) => g.names.push(name.clone()),
             None => groups.push(PickGroup {
@@ -1016,6 +1037,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
                 colour_key_required,
                 no_directions,
                 no_counts,
+                anchors,
             }),
         }
     }
@@ -1055,6 +1077,9 @@ fn named_selections_but(groups: &[PickGroup], tag: &str, but: &[String]) -> Vec<
 /// The selection map of one group, `selmap{suffix}`, and its colour and region rules
 /// (`qcolour{suffix}`, `qncolour{suffix}`, `qregion{suffix}`) where its lists are its own;
 /// `all` are the shared colour and region rules (none: the map has none).
+///
+/// A group with anchors of its own ([`PickGroup::anchors`]) gets the rule `anch{suffix}`:
+/// a pick (`get`) of one of those names, with its group in `picks` selecting it.
 fn group_rules(
     w: &mut Writer,
     suffix: &str,
@@ -1062,7 +1087,28 @@ fn group_rules(
     (all_colours, all_regions): (Option<&str>, Option<&str>),
     vocab: &Vocabulary,
     not_from_end: bool,
+    (picks, get): (&[PickGroup], &str),
 ) {
+    let near = match &group.anchors {
+        None => Some("objn".to_string()),
+        Some(anchors) => {
+            let others: Vec<String> = picks
+                .iter()
+                .flat_map(|g| g.names.iter())
+                .filter(|n| !anchors.contains(n))
+                .cloned()
+                .collect();
+            let alternatives: Vec<String> = named_selections_but(picks, "", &others)
+                .into_iter()
+                .map(|(_, names_sel)| format!("{get} {names_sel} \")\""))
+                .collect();
+            (!alternatives.is_empty()).then(|| {
+                let rule = format!("anch{suffix}");
+                w.rule(&rule, &alternatives.join(" | "));
+                rule
+            })
+        }
+    };
     let colours = match &group.colours {
         None => all_colours.map(str::to_string),
         Some(c) if c.is_empty() => None,
@@ -1092,7 +1138,7 @@ fn group_rules(
         w,
         suffix,
         (colours.as_deref(), not_colours.as_deref()),
-        regions.as_deref(),
+        (regions.as_deref(), near.as_deref()),
         vocab,
         not_from_end,
         (
@@ -1428,7 +1474,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             &mut w,
             "",
             (all_colours, all_colours),
-            all_regions,
+            (all_regions, Some("objn")),
             vocab,
             not_from_end,
             (false, false, false, false),
@@ -1443,6 +1489,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 (all_colours, all_regions),
                 vocab,
                 not_from_end,
+                (groups.as_deref().unwrap_or_default(), &get),
             );
         }
     }
