@@ -2047,48 +2047,6 @@ pub(crate) fn anchors_said(
     out
 }
 
-/// Picks near an object the person named, but not in a clause with the picked object
-/// ([`anchors_said`]), outside a conversation: "whichever sofa is nearest to you, then
-/// pull up to the right of the blue teller desk" picked as the sofa near the teller
-/// desk. An anchor named nowhere, or the object itself, is judged by
-/// [`check_unsaid_anchors`] and [`check_anchor_stops`].
-fn check_anchor_clauses(
-    map: &IvlMap,
-    instruction: &str,
-    plan: &TypedPlan,
-    pose: Pose,
-) -> Vec<Finding> {
-    let said = anchors_said(map, instruction, pose);
-    let mut out: Vec<Finding> = Vec::new();
-    for t in targets(plan) {
-        let Some(Object::Pick(a)) = t.near.as_deref() else {
-            continue;
-        };
-        let (Some(label), Some(anchor)) = (
-            object_label(map, &t.name, pose),
-            object_label(map, &a.name, pose),
-        ) else {
-            continue;
-        };
-        let named = |l: &str| said.iter().any(|(x, _)| x == l);
-        let with = said
-            .iter()
-            .any(|(l, anchors)| *l == label && anchors.contains(&anchor));
-        if label == anchor || !named(&label) || !named(&anchor) || with {
-            continue;
-        }
-        let f = Finding::new(
-            FindingKind::Word,
-            format!("the plan picks the {label} near the {anchor}, but the person did not say the {label} is near the {anchor}: give near only an object said with it (\"the {label} closest to the ...\"); with no near, distances are from the robot"),
-            format!("which {label} do you mean? there are {}", describe_label(map, &label)),
-        );
-        if !out.contains(&f) {
-            out.push(f);
-        }
-    }
-    out
-}
-
 /// Targets that select with `what` whose object (`label` reads a target's name) the
 /// person named in no clause that says it (`said`, from [`said_of`]): the grammar
 /// offers it only to those (`v2::narrow_to_words`).
@@ -2480,8 +2438,11 @@ fn check_anchor_stops(
 
 /// Picks near an object the person never named, by a name or a synonym of it or a typo
 /// of one ("the cabinet nearest to you" as the cabinet `near: get_obj("workbench")`:
-/// held-out v7, dev, hq13, a wrong plan no check saw). Outside a conversation, where an
-/// earlier instruction may have named it.
+/// held-out v7, dev, hq13, a wrong plan no check saw), or named only in another clause
+/// than the picked object ([`anchors_said`]: "whichever sofa is nearest to you, then
+/// pull up to the right of the blue teller desk" as the sofa near the teller desk).
+/// Outside a conversation, where an earlier instruction may have named it. The object
+/// itself as its anchor is [`check_anchor_stops`]'s.
 fn check_unsaid_anchors(
     map: &IvlMap,
     instruction: &str,
@@ -2496,6 +2457,7 @@ fn check_unsaid_anchors(
                 .or_else(|| typed_label_at(map, &w, k).map(|(_, l)| l))
         })
         .collect();
+    let clauses = anchors_said(map, instruction, pose);
     let mut out: Vec<Finding> = Vec::new();
     for t in targets(plan) {
         let Some(Object::Pick(a)) = t.near.as_deref() else {
@@ -2507,13 +2469,25 @@ fn check_unsaid_anchors(
         ) else {
             continue;
         };
-        if said.contains(&anchor) {
+        let to_model = if !said.contains(&anchor) {
+            format!("the plan picks the {label} near a {anchor}, but the person named no {anchor}: give near only an object the person named (with no near, distances are from the robot)")
+        } else if label != anchor
+            && said.contains(&label)
+            && !clauses
+                .iter()
+                .any(|(l, anchors)| *l == label && anchors.contains(&anchor))
+        {
+            format!("the plan picks the {label} near the {anchor}, but the person did not say the {label} is near the {anchor}: give near only an object said with it (\"the {label} closest to the ...\"); with no near, distances are from the robot")
+        } else {
             continue;
-        }
+        };
         let f = Finding::new(
             FindingKind::Word,
-            format!("the plan picks the {label} near a {anchor}, but the person named no {anchor}: give near only an object the person named (with no near, distances are from the robot)"),
-            format!("which {label} do you mean? there are {}", describe_label(map, &label)),
+            to_model,
+            format!(
+                "which {label} do you mean? there are {}",
+                describe_label(map, &label)
+            ),
         );
         if !out.contains(&f) {
             out.push(f);
@@ -2564,7 +2538,6 @@ pub fn check_answer_after(
     out.extend(check_anchor_stops(map, instruction, plan, pose));
     if refs.is_empty() && earlier.is_none() {
         out.extend(check_unsaid_anchors(map, instruction, plan, pose));
-        out.extend(check_anchor_clauses(map, instruction, plan, pose));
     }
     if return_said(instruction) && !plan_returns(plan) {
         let to_model = if refs.is_empty() {
