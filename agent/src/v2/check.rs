@@ -2008,13 +2008,22 @@ pub(crate) fn anchors_said(
     instruction: &str,
     pose: Pose,
 ) -> Vec<(String, Vec<String>)> {
+    anchors_said_by(instruction, |w, j| map_name_at(map, w, j, pose))
+}
+
+/// [`anchors_said`] with names read by `name_at` (the label a name beginning at a word
+/// has, and its length in words), as [`said_of`] reads them.
+pub(crate) fn anchors_said_by(
+    instruction: &str,
+    name_at: impl Fn(&[String], usize) -> Option<(String, usize)>,
+) -> Vec<(String, Vec<String>)> {
     let mut out: Vec<(String, Vec<String>)> = Vec::new();
     let mut before: Vec<String> = Vec::new();
     for w in clauses(instruction) {
         let mut named: Vec<String> = Vec::new();
         let mut j = 0;
         while j < w.len() {
-            match map_name_at(map, &w, j, pose) {
+            match name_at(&w, j) {
                 Some((label, len)) => {
                     named.push(label);
                     j += len.max(1);

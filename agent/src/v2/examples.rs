@@ -312,6 +312,48 @@ mod tests {
                     super::super::check::said_of_others(said.as_deref(), what, &a.plan, last);
                 assert!(elsewhere.is_empty(), "line {}: {elsewhere:?}", e.line);
             }
+            // A pick counts only in the orders the words count in, and is picked near
+            // only an object named with it ([`check::directions_said`],
+            // [`check::anchors_said`]).
+            if let Some(orders) = super::super::check::directions_said(&e.instruction) {
+                for t in a.plan.steps.iter().flat_map(|s| s.targets()) {
+                    assert!(
+                        !t.order.is_directional() || orders.contains(&t.order),
+                        "line {}: {:?} not in {orders:?}",
+                        e.line,
+                        t.order
+                    );
+                }
+            }
+            let anchored: Vec<String> = a
+                .plan
+                .steps
+                .iter()
+                .flat_map(|s| s.targets())
+                .filter_map(|t| match t.near.as_deref() {
+                    Some(planner_dsl::typed::Object::Pick(n)) => last(&n.name),
+                    _ => None,
+                })
+                .collect();
+            let named_at = |w: &[String], j: usize| {
+                let n = single(&w[j]);
+                (picked.contains(&n) || anchored.contains(&n)).then_some((n, 1))
+            };
+            if e.history.is_none() {
+                let said = super::super::check::anchors_said_by(&e.instruction, named_at);
+                for t in a.plan.steps.iter().flat_map(|s| s.targets()) {
+                    let Some(planner_dsl::typed::Object::Pick(n)) = t.near.as_deref() else {
+                        continue;
+                    };
+                    let (label, anchor) = (last(&t.name), last(&n.name));
+                    assert!(
+                        said.iter().any(|(l, a)| Some(l) == label.as_ref()
+                            && anchor.as_ref().is_some_and(|x| a.contains(x))),
+                        "line {}: {label:?} near {anchor:?}, said {said:?}",
+                        e.line
+                    );
+                }
+            }
             let from_end = super::super::check::counted_from_the_end(&a.plan);
             assert!(from_end.is_empty(), "line {}: {from_end:?}", e.line);
             // An example asked to come back moves back (the grammar then requires it).
