@@ -1922,23 +1922,7 @@ pub(crate) fn said_of(
     name_at: impl Fn(&[String], usize) -> Option<(String, usize)>,
 ) -> Option<Vec<String>> {
     let parts = clauses(instruction);
-    let named: Vec<Vec<String>> = parts
-        .iter()
-        .map(|w| {
-            let mut labels = Vec::new();
-            let mut j = 0;
-            while j < w.len() {
-                match name_at(w, j) {
-                    Some((label, len)) => {
-                        labels.push(label);
-                        j += len.max(1);
-                    }
-                    None => j += 1,
-                }
-            }
-            labels
-        })
-        .collect();
+    let named: Vec<Vec<String>> = parts.iter().map(|w| named_in(w, &name_at)).collect();
     let mut out: Vec<String> = Vec::new();
     let mut any = false;
     for (i, w) in parts.iter().enumerate() {
@@ -1960,6 +1944,26 @@ pub(crate) fn said_of(
     out.sort();
     out.dedup();
     any.then_some(out)
+}
+
+/// The labels named in the words `w` of a clause, in order (`name_at`: the label a name
+/// beginning at a word has, and its length in words), each name read once.
+fn named_in(
+    w: &[String],
+    name_at: &impl Fn(&[String], usize) -> Option<(String, usize)>,
+) -> Vec<String> {
+    let mut labels = Vec::new();
+    let mut j = 0;
+    while j < w.len() {
+        match name_at(w, j) {
+            Some((label, len)) => {
+                labels.push(label);
+                j += len.max(1);
+            }
+            None => j += 1,
+        }
+    }
+    labels
 }
 
 /// [`said_of`] on `map`: a name is one the map holds (not a region), else a typo of one
@@ -2020,17 +2024,7 @@ pub(crate) fn anchors_said_by(
     let mut out: Vec<(String, Vec<String>)> = Vec::new();
     let mut before: Vec<String> = Vec::new();
     for w in clauses(instruction) {
-        let mut named: Vec<String> = Vec::new();
-        let mut j = 0;
-        while j < w.len() {
-            match name_at(&w, j) {
-                Some((label, len)) => {
-                    named.push(label);
-                    j += len.max(1);
-                }
-                None => j += 1,
-            }
-        }
+        let named = named_in(&w, &name_at);
         let back = w.iter().any(|x| POINTING_BACK.contains(&x.as_str()));
         for (i, label) in named.iter().enumerate() {
             let mut anchors: Vec<String> = named

@@ -315,8 +315,9 @@ mod tests {
             // A pick counts only in the orders the words count in, and is picked near
             // only an object named with it ([`check::directions_said`],
             // [`check::anchors_said`]).
+            let targets: Vec<_> = a.plan.steps.iter().flat_map(|s| s.targets()).collect();
             if let Some(orders) = super::super::check::directions_said(&e.instruction) {
-                for t in a.plan.steps.iter().flat_map(|s| s.targets()) {
+                for t in &targets {
                     assert!(
                         !t.order.is_directional() || orders.contains(&t.order),
                         "line {}: {:?} not in {orders:?}",
@@ -325,11 +326,8 @@ mod tests {
                     );
                 }
             }
-            let anchored: Vec<String> = a
-                .plan
-                .steps
+            let anchored: Vec<String> = targets
                 .iter()
-                .flat_map(|s| s.targets())
                 .filter_map(|t| match t.near.as_deref() {
                     Some(planner_dsl::typed::Object::Pick(n)) => last(&n.name),
                     _ => None,
@@ -341,7 +339,7 @@ mod tests {
             };
             if e.history.is_none() {
                 let said = super::super::check::anchors_said_by(&e.instruction, named_at);
-                for t in a.plan.steps.iter().flat_map(|s| s.targets()) {
+                for t in &targets {
                     let Some(planner_dsl::typed::Object::Pick(n)) = t.near.as_deref() else {
                         continue;
                     };
