@@ -110,6 +110,10 @@ pub struct PlanOptions {
     /// end) only where the person said a count of its object, in the clause naming it
     /// (default on; `--counts-anywhere` turns it off).
     pub counts_of_said: bool,
+    /// With `said_only`, outside a conversation: a pick may count in `far_to_near` only
+    /// where the person spoke of the far end of its object, in the clause naming it
+    /// (default on; `--far-end-anywhere` turns it off).
+    pub far_ends_of_said: bool,
     /// With `said_only`, outside a conversation: `move_between_the_two` may name only
     /// an object the person said in the plural ("between the two red stools"; default
     /// on; `--pairs-anywhere` turns it off).
@@ -177,6 +181,7 @@ impl Default for PlanOptions {
             said_exclusions: true,
             directions_of_said: true,
             counts_of_said: true,
+            far_ends_of_said: true,
             pairs_of_said: true,
             orders_of_said: true,
             anchors_of_said: true,

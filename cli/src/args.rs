@@ -293,6 +293,11 @@ pub(crate) struct ModelArgs {
     /// the west" in `east_to_west`; the default before stop 67; for comparison).
     #[arg(long)]
     pub(crate) any_direction: bool,
+    /// Let a pick count from the far end (`far_to_near`) wherever the instruction speaks
+    /// of a far end, not only where it does of that object (the default before stop 68;
+    /// for comparison).
+    #[arg(long)]
+    pub(crate) far_end_anywhere: bool,
     /// Let a pick be picked near any object, not only one the person named in a clause
     /// with it (the default before stop 67; for comparison).
     #[arg(long)]
@@ -370,6 +375,7 @@ impl ModelArgs {
             said_exclusions: !self.any_not_colours,
             directions_of_said: !self.directions_anywhere,
             counts_of_said: !self.counts_anywhere,
+            far_ends_of_said: !self.far_end_anywhere,
             pairs_of_said: !self.pairs_anywhere,
             orders_of_said: !self.any_direction,
             anchors_of_said: !self.anchors_anywhere,

@@ -97,6 +97,18 @@ impl Side {
         Side::ALL.iter().find(|(_, n)| *n == f).map(|(s, _)| *s)
     }
 
+    /// The move to the side a word names, read off the function's name: "left" is
+    /// `move_to_left`, "north" is `move_north`; `None` for a word that names no side a
+    /// move goes to (the turns `with_object_on_left/right` are not moves).
+    #[must_use]
+    pub fn toward(word: &str) -> Option<Side> {
+        Side::ALL
+            .iter()
+            .filter(|(s, _)| s.is_move())
+            .find(|(_, f)| f.rsplit('_').next() == Some(word))
+            .map(|(s, _)| *s)
+    }
+
     /// Whether the function moves the robot to that side (not a turn in place).
     #[must_use]
     pub fn is_move(self) -> bool {

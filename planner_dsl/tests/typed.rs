@@ -277,6 +277,20 @@ fn each_side_function_names_its_side_and_only_the_turns_do_not_move() {
         assert_eq!(Side::from_function(side.function()), Some(side));
     }
     assert_eq!(Side::from_function("move_to_object"), None);
+    for (word, side) in [
+        ("left", Side::Left),
+        ("right", Side::Right),
+        ("north", Side::North),
+        ("south", Side::South),
+        ("east", Side::East),
+        ("west", Side::West),
+    ] {
+        assert_eq!(Side::toward(word), Some(side), "{word}");
+        assert!(side.function().ends_with(word));
+    }
+    for word in ["object", "on", "to", "Left", "northern", ""] {
+        assert_eq!(Side::toward(word), None, "{word}");
+    }
     assert_eq!(Side::from_function("move_north "), None);
     let moves: Vec<&str> = all
         .iter()

@@ -54,6 +54,10 @@ pub struct Vocabulary {
     /// ([`check::said_of`](super::check::said_of)); the others
     /// count only 1 or -1.
     pub counts_of: Option<Vec<String>>,
+    /// The names a pick may count in `far_to_near` (`None`: every name, unless
+    /// `no_far_end`): outside a conversation, those the person spoke of the far end of
+    /// ([`check::said_of`](super::check::said_of)).
+    pub far_ends_of: Option<Vec<String>>,
     /// The names a pick of each name may be picked near (`near:`), as groups of names
     /// sharing one list (`None`: any name; a name in no group, or in a group with an
     /// empty list, takes no `near:`): outside a conversation, the objects the person
@@ -220,6 +224,7 @@ impl Vocabulary {
             no_far_end: false,
             directions_of: None,
             counts_of: None,
+            far_ends_of: None,
             anchors_of: None,
             colour_required: Vec::new(),
             colour_key_required: Vec::new(),
@@ -436,25 +441,26 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
         "\"objects: [\" (tuple (\", \" tuple){0,15})? \"]\"",
     );
     let tuple_orders = offered_orders(vocab, false);
-    let undirected: Vec<&str> = tuple_orders
-        .iter()
-        .copied()
-        .filter(|o| ObjectOrder::parse(o).is_ok_and(|o| !o.is_directional()))
-        .collect();
-    // Where a direction or a count is said of some objects only
-    // ([`Vocabulary::directions_of`], [`Vocabulary::counts_of`]), a tuple counts in a
-    // direction, or two or more, only under one of their names, as the plan does:
+    // Where a direction, a count or the far end is said of some objects only
+    // ([`Vocabulary::directions_of`], [`Vocabulary::counts_of`],
+    // [`Vocabulary::far_ends_of`]), a tuple counts in a direction, two or more, or
+    // `far_to_near`, only under one of their names, as the plan does:
     // measured on held-out v8 (dev), with only the plan narrowed the default model
     // listed `(microscope, 2, None, west_to_east)` for "the penultimate microscope" and
     // then, refused that order in the plan, picked the microscope near the freezer.
-    // A word of no such name (the free `tword`) gets neither.
-    let (directed, counted) = (vocab.directions_of.as_ref(), vocab.counts_of.as_ref());
-    let free = (directed.is_none(), counted.is_none());
-    let mut classes: Vec<((bool, bool), Vec<String>)> = Vec::new();
+    // A word of no such name (the free `tword`) gets none of them.
+    let (directed, counted, far) = (
+        vocab.directions_of.as_ref(),
+        vocab.counts_of.as_ref(),
+        vocab.far_ends_of.as_ref(),
+    );
+    let free = (directed.is_none(), counted.is_none(), far.is_none());
+    let mut classes: Vec<((bool, bool, bool), Vec<String>)> = Vec::new();
     for n in &vocab.names {
         let c = (
             directed.is_none_or(|d| d.contains(n)),
             counted.is_none_or(|d| d.contains(n)),
+            far.is_none_or(|d| d.contains(n)),
         );
         if c == free {
             continue;
@@ -464,17 +470,38 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
             None => classes.push((c, vec![n.clone()])),
         }
     }
-    let tuple = |word: &str, (direction, count): (bool, bool)| {
-        let ordinal = if count { "tordinal" } else { "tordinal1" };
-        let (orders, rule) = if direction {
-            (&tuple_orders, "torder")
-        } else {
-            (&undirected, "torderu")
-        };
-        if orders.is_empty() {
-            format!("\"(\" {word} \", \" {ordinal} \", \" tcolour \")\"")
-        } else {
-            format!("\"(\" {word} \", \" {ordinal} \", \" tcolour (\", \" {rule})? \")\"")
+    // The order rule of a class: `torder`, less the directional orders (`u`), less
+    // `far_to_near` (`e`); `None` where it offers none.
+    let order_rule = |(direction, _, far_end): (bool, bool, bool)| {
+        let rule = format!(
+            "torder{}{}",
+            if direction { "" } else { "u" },
+            if far_end { "" } else { "e" }
+        );
+        let orders: Vec<&str> = tuple_orders
+            .iter()
+            .copied()
+            .filter(|o| {
+                ObjectOrder::parse(o).is_ok_and(|o| {
+                    (direction || !o.is_directional()) && (far_end || o != ObjectOrder::FarToNear)
+                })
+            })
+            .collect();
+        (!orders.is_empty()).then_some((rule, orders))
+    };
+    let mut order_rules: Vec<(String, Vec<&str>)> = Vec::new();
+    let mut tuple = |word: &str, c: (bool, bool, bool)| {
+        let ordinal = if c.1 { "tordinal" } else { "tordinal1" };
+        match order_rule(c) {
+            None => format!("\"(\" {word} \", \" {ordinal} \", \" tcolour \")\""),
+            Some((rule, orders)) => {
+                let out =
+                    format!("\"(\" {word} \", \" {ordinal} \", \" tcolour (\", \" {rule})? \")\"");
+                if !order_rules.iter().any(|(r, _)| *r == rule) {
+                    order_rules.push((rule, orders));
+                }
+                out
+            }
         }
     };
     let mut alternatives = vec![tuple("tword", free)];
@@ -483,11 +510,8 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
         alternatives.push(tuple(&format!("tword{k}"), *c));
     }
     w.rule("tuple", &alternatives.join(" | "));
-    if !tuple_orders.is_empty() {
-        w.rule("torder", &alt(&tuple_orders, false));
-    }
-    if !undirected.is_empty() && directed.is_some() {
-        w.rule("torderu", &alt(&undirected, false));
+    for (rule, orders) in &order_rules {
+        w.rule(rule, &alt(orders, false));
     }
     let tword = w.pattern(
         "[a-z] [a-z-]{0,15} (\" \" [a-z] [a-z-]{0,15}){0,2}",
@@ -713,8 +737,8 @@ struct SelKeys<'a> {
     colour_required: bool,
     /// The map ends only after a `colour:` or `not_colour:` key (only with `colour`).
     colour_key_required: bool,
-    /// The suffix of the order rules: `""` for `qorder`, `qordern` and `qorderf`, `"d"`
-    /// for those less the directional orders ([`PickGroup::no_directions`]).
+    /// The suffix of the order rules: `""` for `qorder`, `qordern` and `qorderf`, else
+    /// [`PickGroup::orders`].
     orders: &'a str,
     /// The suffix of the ordinal rules: `""` for `pint` and `nint`, `"1"` for 1 and -1
     /// alone ([`PickGroup::no_counts`]).
@@ -838,8 +862,9 @@ impl SelKeys<'_> {
 /// biggest bed" as the last largest-first, the smallest): one way to write each
 /// meaning, the one that reads as it is said ([`check`](super::check) finds the other).
 ///
-/// With `no_directions` its orders are those less the directional ones (rules
-/// `qorderd`, `qordernd`, `qorderfd`: [`PickGroup::no_directions`]).
+/// `orders` is the suffix of its order rules ([`PickGroup::orders`]): with `d`, those
+/// less the directional ones (`qorderd`, `qordernd`, `qorderfd`); with `e`, those less
+/// `far_to_near`.
 fn selection_rules(
     w: &mut Writer,
     suffix: &str,
@@ -847,7 +872,7 @@ fn selection_rules(
     (region, near): (Option<&str>, Option<&str>),
     vocab: &Vocabulary,
     not_from_end: bool,
-    (colour_required, colour_key_required, no_directions, no_counts): (bool, bool, bool, bool),
+    (colour_required, colour_key_required, orders, no_counts): (bool, bool, &str, bool),
 ) {
     let (positive, negative) = ordinal_signs(vocab);
     let keys = SelKeys {
@@ -859,7 +884,7 @@ fn selection_rules(
         not_from_end,
         colour_required: colour_required && colour.is_some(),
         colour_key_required: colour_key_required && colour.is_some(),
-        orders: if no_directions { "d" } else { "" },
+        orders,
         ints: if no_counts { "1" } else { "" },
         near,
     };
@@ -938,9 +963,25 @@ struct PickGroup {
     no_directions: bool,
     /// Its picks count only 1 or -1 ([`Vocabulary::counts_of`]).
     no_counts: bool,
+    /// Its picks count in no `far_to_near`: the vocabulary offers it only to other names
+    /// ([`Vocabulary::far_ends_of`]).
+    no_far_end: bool,
     /// The names its picks may be picked near (`None`: any; empty: no `near:`;
     /// [`Vocabulary::anchors_of`]). Pair groups take any.
     anchors: Option<Vec<String>>,
+}
+
+impl PickGroup {
+    /// The suffix of its order rules: `d` less the directional orders
+    /// ([`PickGroup::no_directions`]), `e` less `far_to_near` ([`PickGroup::no_far_end`]).
+    fn orders(&self) -> &'static str {
+        match (self.no_directions, self.no_far_end) {
+            (false, false) => "",
+            (true, false) => "d",
+            (false, true) => "e",
+            (true, true) => "de",
+        }
+    }
 }
 
 /// The list of the group holding `name` in `groups` ([`Vocabulary::colours_of`],
@@ -971,6 +1012,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
         && vocab.colour_key_required.is_empty()
         && vocab.directions_of.is_none()
         && vocab.counts_of.is_none()
+        && vocab.far_ends_of.is_none()
         && vocab.anchors_of.is_none()
     {
         return None;
@@ -1013,6 +1055,10 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
             .as_ref()
             .is_some_and(|d| !d.contains(name));
         let no_counts = vocab.counts_of.as_ref().is_some_and(|d| !d.contains(name));
+        let no_far_end = vocab
+            .far_ends_of
+            .as_ref()
+            .is_some_and(|d| !d.contains(name));
         let anchors = match &vocab.anchors_of {
             Some(a) if !pairs => Some(group_list(Some(a), name).unwrap_or_default()),
             _ => None,
@@ -1025,6 +1071,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
                 && g.colour_key_required == colour_key_required
                 && g.no_directions == no_directions
                 && g.no_counts == no_counts
+                && g.no_far_end == no_far_end
                 && g.anchors == anchors
         }) {
             Some(g) => g.names.push(name.clone()),
@@ -1037,6 +1084,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
                 colour_key_required,
                 no_directions,
                 no_counts,
+                no_far_end,
                 anchors,
             }),
         }
@@ -1144,7 +1192,7 @@ fn group_rules(
         (
             group.colour_required,
             group.colour_key_required,
-            group.no_directions,
+            group.orders(),
             group.no_counts,
         ),
     );
@@ -1437,27 +1485,40 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     if !not_from_end.is_empty() {
         w.rule("qorderf", &alt(&not_from_end, true));
     }
-    // The same less the directional orders, for the picks of names no direction is said
-    // of ([`PickGroup::no_directions`]); `far_to_near` and those by size are none.
-    let undirected = |list: &[&'static str]| -> Vec<&'static str> {
+    // The same less the directional orders (suffix `d`, [`PickGroup::no_directions`]),
+    // less `far_to_near` (`e`, [`PickGroup::no_far_end`]) or less both, for the picks of
+    // names no direction or no far end is said of; `qorderf` with a suffix only where it
+    // offers an order (a group's `not_from_end`).
+    let cut = |list: &[&'static str], sfx: &str| -> Vec<&'static str> {
         list.iter()
             .copied()
-            .filter(|o| ObjectOrder::parse(o).is_ok_and(|o| !o.is_directional()))
+            .filter(|o| {
+                ObjectOrder::parse(o).is_ok_and(|o| {
+                    (!sfx.contains('d') || !o.is_directional())
+                        && (!sfx.contains('e') || o != ObjectOrder::FarToNear)
+                })
+            })
             .collect()
     };
-    let groups_undirected = [&groups, &pair_groups]
-        .iter()
-        .any(|g| g.iter().flatten().any(|g| g.no_directions));
-    if groups_undirected {
-        w.rule("qorderd", &alt(&undirected(&offered), true));
-        w.rule("qordernd", &alt(&undirected(&from_end), true));
-        if !not_from_end.is_empty() {
-            w.rule("qorderfd", &alt(&undirected(&not_from_end), true));
+    let mut suffixes: Vec<&'static str> = Vec::new();
+    for g in [&groups, &pair_groups].into_iter().flatten().flatten() {
+        let sfx = g.orders();
+        if !sfx.is_empty() && !suffixes.contains(&sfx) {
+            suffixes.push(sfx);
         }
     }
+    for sfx in &suffixes {
+        w.rule(&format!("qorder{sfx}"), &alt(&cut(&offered, sfx), true));
+        w.rule(&format!("qordern{sfx}"), &alt(&cut(&from_end, sfx), true));
+        let rest = cut(&not_from_end, sfx);
+        if !rest.is_empty() {
+            w.rule(&format!("qorderf{sfx}"), &alt(&rest, true));
+        }
+    }
+    let not_from_end_of = |sfx: &str| !cut(&not_from_end, sfx).is_empty();
     let all_colours = (!vocab.colours.is_empty()).then_some("qcolour");
     let all_regions = (!keys.is_empty()).then_some("qregion");
-    let not_from_end = !not_from_end.is_empty();
+    let shared_not_from_end = !not_from_end.is_empty();
     // `move_between_the_two`'s name and selection: per pair group, or the shared map.
     match &pair_groups {
         Some(groups) if !groups.is_empty() => {
@@ -1476,8 +1537,8 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             (all_colours, all_colours),
             (all_regions, Some("objn")),
             vocab,
-            not_from_end,
-            (false, false, false, false),
+            shared_not_from_end,
+            (false, false, "", false),
         );
     }
     for (tag, gs) in [("", &groups), ("p", &pair_groups)] {
@@ -1488,7 +1549,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 group,
                 (all_colours, all_regions),
                 vocab,
-                not_from_end,
+                not_from_end_of(group.orders()),
                 (groups.as_deref().unwrap_or_default(), &get),
             );
         }
