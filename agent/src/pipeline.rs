@@ -114,6 +114,11 @@ pub struct PlanOptions {
     /// where the person spoke of the far end of its object, in the clause naming it
     /// (default on; `--far-end-anywhere` turns it off).
     pub far_ends_of_said: bool,
+    /// With `said_only`, outside a conversation: `move_to_object` (and a `let`) may not
+    /// take an object the person named once, as a stop at one of its sides ("stop on
+    /// the north side of the red sofa": `check::sides_said_of_once`; default on;
+    /// `--plain-stops-anywhere` turns it off).
+    pub side_stops_of_said: bool,
     /// With `said_only`, outside a conversation: `move_between_the_two` may name only
     /// an object the person said in the plural ("between the two red stools"; default
     /// on; `--pairs-anywhere` turns it off).
@@ -182,6 +187,7 @@ impl Default for PlanOptions {
             directions_of_said: true,
             counts_of_said: true,
             far_ends_of_said: true,
+            side_stops_of_said: true,
             pairs_of_said: true,
             orders_of_said: true,
             anchors_of_said: true,

@@ -123,7 +123,16 @@ pub struct Vocabulary {
     /// ([`check::Bar::AnchorStop`](super::check::Bar::AnchorStop)). Empty: no such bar,
     /// and the grammar is the same as without the field.
     pub no_stops: Vec<String>,
+    /// Names `move_to_object` may not take, nor a `let` bind; a side move, a face or an
+    /// anchor may still: a re-ask after a side stop the person asked for that the plan
+    /// made a plain stop ([`check::Bar::SideStop`](super::check::Bar::SideStop)).
+    /// Empty: no such bar, and the grammar is the same as without the field.
+    pub no_goto: Vec<String>,
 }
+
+/// The step function of a plain stop at an object ([`Step::GoTo`](planner_dsl::typed::Step::GoTo)),
+/// which [`Vocabulary::no_goto`] bars.
+const GOTO_FUNCTION: &str = "move_to_object";
 
 /// The colours and regions a pair of objects of one name ("between the two yellow
 /// tables") may be selected on: [`Vocabulary::pairs_of`].
@@ -238,6 +247,7 @@ impl Vocabulary {
             said_words: Vec::new(),
             tuple_colours: None,
             no_stops: Vec::new(),
+            no_goto: Vec::new(),
         }
     }
 
@@ -1315,17 +1325,38 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     };
     // With names barred from stops (`no_stops`), the steps' objects and the `let`s are
     // of the `s...` rules, which leave them out; an anchor (`near:`) is any pick still.
-    // A bar that would leave no name to stop at bars nothing.
-    let barred =
-        vocab.names.iter().any(|n| !vocab.no_stops.contains(n)) && !vocab.no_stops.is_empty();
-    let (spick, sobj, sobjn) = if barred {
-        ("spick", "sobj", "sobjn")
-    } else {
-        ("pick", "obj", "objn")
+    // With names barred from plain stops too (`no_goto`), `move_to_object`'s object and
+    // the `let`s are of the `g...` rules, which leave out both lists. A bar that would
+    // leave no name to stop at bars nothing.
+    let stop_barred = vocab.no_stops.clone();
+    let mut goto_barred = stop_barred.clone();
+    goto_barred.extend(
+        vocab
+            .no_goto
+            .iter()
+            .filter(|n| !stop_barred.contains(n))
+            .cloned(),
+    );
+    let bars = |list: &[String]| !list.is_empty() && vocab.names.iter().any(|n| !list.contains(n));
+    // Without `no_goto` the `g...` rules are the `s...` ones: the same grammar text.
+    let goto_only = goto_barred.len() > stop_barred.len();
+    let barring: Vec<(&str, &[String])> = [("s", &stop_barred), ("g", &goto_barred)]
+        .into_iter()
+        .filter(|(p, list)| bars(list) && (*p == "s" || goto_only))
+        .map(|(p, list)| (p, list.as_slice()))
+        .collect();
+    let rules_of = |p: &str| -> [String; 3] {
+        if barring.iter().any(|(b, _)| *b == p) {
+            [format!("{p}pick"), format!("{p}obj"), format!("{p}objn")]
+        } else {
+            ["pick".into(), "obj".into(), "objn".into()]
+        }
     };
+    let [_, sobj, sobjn] = rules_of("s");
+    let [gpick, gobj, gobjn] = rules_of(if goto_only { "g" } else { "s" });
     w.rule(
         "letstmt",
-        &format!("{comment}\"let \" var \" = \" {spick} \";\""),
+        &format!("{comment}\"let \" var \" = \" {gpick} \";\""),
     );
     // The groups of `move_between_the_two`'s names: with none, it is left out.
     let pair_groups = pick_groups(vocab, true);
@@ -1336,11 +1367,9 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         .copied()
         .partition(|n| RETURN_FUNCTIONS.contains(n));
     // Each statement rule twice: with a variable on offer (`obj`) and without (`objn`).
-    for (sfx, obj) in [("", sobj), ("n", sobjn)] {
-        let steps: Vec<String> = STEP_FUNCTIONS
-            .iter()
-            .filter_map(|n| call_rule(n, obj, pairs))
-            .collect();
+    for (sfx, obj, goto) in [("", &sobj, &gobj), ("n", &sobjn, &gobjn)] {
+        let call = |n: &&str| call_rule(n, if *n == GOTO_FUNCTION { goto } else { obj }, pairs);
+        let steps: Vec<String> = STEP_FUNCTIONS.iter().filter_map(call).collect();
         w.rule(
             &format!("step{sfx}"),
             &format!("({}) \";\"", steps.join(" | ")),
@@ -1351,12 +1380,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             w.rule("stmtn", &format!("{comment}stepn"));
         }
         if vocab.return_required {
-            let rules = |names: &[&str]| -> Vec<String> {
-                names
-                    .iter()
-                    .filter_map(|n| call_rule(n, obj, pairs))
-                    .collect()
-            };
+            let rules = |names: &[&str]| -> Vec<String> { names.iter().filter_map(call).collect() };
             if sfx.is_empty() {
                 w.rule("stmt_nr", &format!("letstmt | {comment}step_nr"));
             } else {
@@ -1392,44 +1416,46 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 picks.push(format!("pick{g}"));
             }
             w.rule("pick", &picks.join(" | "));
-            if barred {
-                let spicks: Vec<String> = named_selections_but(groups, "", &vocab.no_stops)
+            for (p, list) in &barring {
+                let kept: Vec<String> = named_selections_but(groups, "", list)
                     .into_iter()
                     .map(|(g, names_sel)| {
                         let all = &groups[g].names;
-                        if all.iter().any(|n| vocab.no_stops.contains(n)) {
+                        if all.iter().any(|n| list.contains(n)) {
                             format!("{get} {names_sel} \")\"")
                         } else {
                             format!("pick{g}")
                         }
                     })
                     .collect();
-                w.rule("spick", &spicks.join(" | "));
+                w.rule(&format!("{p}pick"), &kept.join(" | "));
             }
         }
         _ => {
             w.rule("pick", &format!("{get} pname (\", \" selmap)? \")\""));
-            if barred {
-                w.rule("spick", &format!("{get} spname (\", \" selmap)? \")\""));
+            for (p, _) in &barring {
+                w.rule(
+                    &format!("{p}pick"),
+                    &format!("{get} {p}pname (\", \" selmap)? \")\""),
+                );
             }
         }
     }
-    if barred {
-        let kept: Vec<&String> = vocab
-            .names
-            .iter()
-            .filter(|n| !vocab.no_stops.contains(n))
-            .collect();
-        w.rule("spname", &alt(&kept, true));
-        let sqname = if vocab.regions.is_empty() {
-            "spname".to_string()
+    for (p, list) in &barring {
+        let kept: Vec<&String> = vocab.names.iter().filter(|n| !list.contains(n)).collect();
+        w.rule(&format!("{p}pname"), &alt(&kept, true));
+        let qname = if vocab.regions.is_empty() {
+            format!("{p}pname")
         } else {
-            format!("spname | {}", alt(&vocab.regions, true))
+            format!("{p}pname | {}", alt(&vocab.regions, true))
         };
         let inst = if vocab.ids.is_empty() { "" } else { " | inst" };
-        w.rule("sqname", &sqname);
-        w.rule("sobj", &format!("spick | sqname | var{inst}"));
-        w.rule("sobjn", &format!("spick | sqname{inst}"));
+        w.rule(&format!("{p}qname"), &qname);
+        w.rule(
+            &format!("{p}obj"),
+            &format!("{p}pick | {p}qname | var{inst}"),
+        );
+        w.rule(&format!("{p}objn"), &format!("{p}pick | {p}qname{inst}"));
     }
     // An anchor (`near:`) is never a variable: it is written inside a pick, where the
     // grammar does not know whether a `let` came before.
