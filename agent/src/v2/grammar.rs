@@ -1770,7 +1770,10 @@ pub(crate) mod tests {
                 for (i, part) in line.split('"').enumerate() {
                     if i % 2 == 1 {
                         v.names.push(part.to_string());
-                        v.colours.push(part.to_string());
+                        // A map's colours are single words ("music room" is none).
+                        if !part.contains(' ') {
+                            v.colours.push(part.to_string());
+                        }
                         v.regions.push(part.to_string());
                     }
                 }

@@ -358,7 +358,10 @@ fn narrow_far_ends(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str
 /// face or an anchor may still take them. Its check is `check_side_moves`. Held-out v8
 /// and v9 (dev since their third runs, read per task at stop 68): hu14, hw14 and ht06
 /// stopped at the teller desk, the fountain and the sofa themselves; ht06's first
-/// answer had `move_north` and its re-ask for another finding dropped it.
+/// answer had `move_north` and its re-ask for another finding dropped it. Off by
+/// default (`PlanOptions::side_stops_of_said`): on v9 (dev) the default model that
+/// began `move_to_object(` for the table of "park on the south side of the green
+/// table" went on with another object and lost hw06.
 fn narrow_side_stops(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str, pose: Pose) {
     let labels = check::sides_said_of_once(map, instruction, pose);
     v.no_goto = names_of_labels(v, map, &labels, pose);
@@ -1744,7 +1747,16 @@ mod tests {
     #[test]
     fn an_object_named_once_as_a_side_stop_takes_no_plain_stop() {
         let said = "stop on the north side of the red sofa, then the tv";
-        let v = narrowed(said, &[]);
+        let m = map();
+        let barring = |s: &str| {
+            let mut ctx = PlanContext::new(&m);
+            ctx.options.side_stops_of_said = true;
+            let mut v = Vocabulary::for_map(&m);
+            v.map_colours(&m);
+            narrow_to_words(&mut v, s, &ctx);
+            v
+        };
+        let v = barring(said);
         for name in ["sofa", "couch"] {
             assert!(v.no_goto.contains(&name.to_string()), "{:?}", v.no_goto);
         }
@@ -1754,10 +1766,10 @@ mod tests {
             "go to the red sofa, then stop on the north side of the sofa",
             "go to the red sofa, then the tv",
         ] {
-            assert!(narrowed(s, &[]).no_goto.is_empty(), "{s}");
+            assert!(barring(s).no_goto.is_empty(), "{s}");
         }
         grammar::tests::assert_offers(
-            &narrowed_grammar(said),
+            &answer_lark(&v),
             |p| format!("objects: [(sofa, None, red), (tv, None, None)]\nplan:\n{p}"),
             &[
                 "move_north(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to_object(get_obj(\"tv\"));",
@@ -1770,13 +1782,8 @@ mod tests {
                 "let s = get_obj(\"sofa\");\nmove_north(s);",
             ],
         );
-        // Without the narrowing a plain stop is offered.
-        let m = map();
-        let mut ctx = PlanContext::new(&m);
-        ctx.options.side_stops_of_said = false;
-        let mut v = Vocabulary::for_map(&m);
-        narrow_to_words(&mut v, said, &ctx);
-        assert!(v.no_goto.is_empty());
+        // By default (`PlanOptions::side_stops_of_said` off) a plain stop is offered.
+        assert!(narrowed(said, &[]).no_goto.is_empty());
     }
 
     #[test]
