@@ -91,10 +91,11 @@ pub enum Bar {
     CountFromStart,
     /// No `move_to_object` takes an object of this map label (or its synonyms), nor a
     /// `let` binds one; a side move, a face or an anchor still may. The person asked to
-    /// stop at a side of it, and the plan had no move to that side
-    /// (`check_side_moves`; measured without the bar on held-out v8, dev, ht06: a
-    /// re-ask for another finding dropped the first answer's `move_north`, and the two
-    /// re-asks that named it left the plain stop as it was).
+    /// stop at a side of it, and the first answer had no move to that side
+    /// (`check_side_moves`). Not measured on its own: on held-out v8 (dev) ht06 the
+    /// first answer had the side move and a re-ask for other findings dropped it, where
+    /// a bar from the first answer's findings does not reach; the two answers after
+    /// that kept the plain stop.
     SideStop {
         /// The map label.
         label: String,
