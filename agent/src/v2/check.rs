@@ -2745,23 +2745,25 @@ pub fn check_answer_after(
         format!("the plan picks the {} that is not {c}, but the person {what}: leave not_colour out unless their words exclude a colour (\"not\", \"isn't\", \"other than\")", t.name)
     };
     // Outside a conversation, where a direction is said of some objects only.
-    let directed = (refs.is_empty() && earlier.is_none())
-        .then(|| said_of_map(map, instruction, pose, SaidOf::Direction))
-        .flatten();
+    let said_of_kind = |what| {
+        (refs.is_empty() && earlier.is_none())
+            .then(|| said_of_map(map, instruction, pose, what))
+            .flatten()
+    };
+    let others_of = |said: &Option<Vec<String>>, what| {
+        said_of_others(said.as_deref(), what, plan, |n| object_label(map, n, pose))
+    };
+    let directed = said_of_kind(SaidOf::Direction);
     let others = |t: &Target| {
         let of = directed.as_deref().unwrap_or_default().join(", the ");
         format!("the plan counts the {} in order \"{}\", but the person named a direction only for the {of}: leave the {}'s order out (nearest first) unless their words about it give one", t.name, t.order.name(), t.name)
     };
-    let counted = (refs.is_empty() && earlier.is_none())
-        .then(|| said_of_map(map, instruction, pose, SaidOf::Count))
-        .flatten();
+    let counted = said_of_kind(SaidOf::Count);
     let counts_of_others = |t: &Target| {
         let of = counted.as_deref().unwrap_or_default().join(", the ");
         format!("the plan picks the {} with ordinal {}, but the person said a count only of the {of}: leave the {}'s ordinal out unless their words about it count", t.name, t.ordinal, t.name)
     };
-    let far_ended = (refs.is_empty() && earlier.is_none())
-        .then(|| said_of_map(map, instruction, pose, SaidOf::FarEnd))
-        .flatten();
+    let far_ended = said_of_kind(SaidOf::FarEnd);
     let far_ends_of_others = |t: &Target| {
         let of = far_ended.as_deref().unwrap_or_default().join(", the ");
         format!("the plan counts the {} in order \"far_to_near\", but the person spoke of the far end only for the {of}: leave the {}'s order out (nearest first) unless their words about it count from far away", t.name, t.name)
@@ -2786,23 +2788,13 @@ pub fn check_answer_after(
             "",
         ),
         (
-            said_of_others(directed.as_deref(), SaidOf::Direction, plan, |n| {
-                object_label(map, n, pose)
-            }),
+            others_of(&directed, SaidOf::Direction),
             &others,
             ", counting from where",
         ),
+        (others_of(&counted, SaidOf::Count), &counts_of_others, ""),
         (
-            said_of_others(counted.as_deref(), SaidOf::Count, plan, |n| {
-                object_label(map, n, pose)
-            }),
-            &counts_of_others,
-            "",
-        ),
-        (
-            said_of_others(far_ended.as_deref(), SaidOf::FarEnd, plan, |n| {
-                object_label(map, n, pose)
-            }),
+            others_of(&far_ended, SaidOf::FarEnd),
             &far_ends_of_others,
             "",
         ),

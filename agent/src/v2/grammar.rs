@@ -488,15 +488,7 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
             if direction { "" } else { "u" },
             if far_end { "" } else { "e" }
         );
-        let orders: Vec<&str> = tuple_orders
-            .iter()
-            .copied()
-            .filter(|o| {
-                ObjectOrder::parse(o).is_ok_and(|o| {
-                    (direction || !o.is_directional()) && (far_end || o != ObjectOrder::FarToNear)
-                })
-            })
-            .collect();
+        let orders = orders_less(&tuple_orders, !direction, !far_end);
         (!orders.is_empty()).then_some((rule, orders))
     };
     let mut order_rules: Vec<(String, Vec<&str>)> = Vec::new();
@@ -992,6 +984,26 @@ impl PickGroup {
             (true, true) => "de",
         }
     }
+
+    /// The orders of `list` its picks may count in ([`orders_less`]).
+    fn orders_of<'a>(&self, list: &[&'a str]) -> Vec<&'a str> {
+        orders_less(list, self.no_directions, self.no_far_end)
+    }
+}
+
+/// `list` less the directional orders (with `no_directions`) and less `far_to_near`
+/// (with `no_far_end`): what a pick, or a tuple on the objects line, may count in where
+/// no direction or no far end is said of its object.
+fn orders_less<'a>(list: &[&'a str], no_directions: bool, no_far_end: bool) -> Vec<&'a str> {
+    list.iter()
+        .copied()
+        .filter(|o| {
+            ObjectOrder::parse(o).is_ok_and(|o| {
+                (!no_directions || !o.is_directional())
+                    && (!no_far_end || o != ObjectOrder::FarToNear)
+            })
+        })
+        .collect()
 }
 
 /// The list of the group holding `name` in `groups` ([`Vocabulary::colours_of`],
@@ -1515,33 +1527,23 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     // less `far_to_near` (`e`, [`PickGroup::no_far_end`]) or less both, for the picks of
     // names no direction or no far end is said of; `qorderf` with a suffix only where it
     // offers an order (a group's `not_from_end`).
-    let cut = |list: &[&'static str], sfx: &str| -> Vec<&'static str> {
-        list.iter()
-            .copied()
-            .filter(|o| {
-                ObjectOrder::parse(o).is_ok_and(|o| {
-                    (!sfx.contains('d') || !o.is_directional())
-                        && (!sfx.contains('e') || o != ObjectOrder::FarToNear)
-                })
-            })
-            .collect()
-    };
-    let mut suffixes: Vec<&'static str> = Vec::new();
+    let mut written: Vec<&'static str> = Vec::new();
     for g in [&groups, &pair_groups].into_iter().flatten().flatten() {
         let sfx = g.orders();
-        if !sfx.is_empty() && !suffixes.contains(&sfx) {
-            suffixes.push(sfx);
+        if sfx.is_empty() || written.contains(&sfx) {
+            continue;
         }
-    }
-    for sfx in &suffixes {
-        w.rule(&format!("qorder{sfx}"), &alt(&cut(&offered, sfx), true));
-        w.rule(&format!("qordern{sfx}"), &alt(&cut(&from_end, sfx), true));
-        let rest = cut(&not_from_end, sfx);
+        written.push(sfx);
+        w.rule(&format!("qorder{sfx}"), &alt(&g.orders_of(&offered), true));
+        w.rule(
+            &format!("qordern{sfx}"),
+            &alt(&g.orders_of(&from_end), true),
+        );
+        let rest = g.orders_of(&not_from_end);
         if !rest.is_empty() {
             w.rule(&format!("qorderf{sfx}"), &alt(&rest, true));
         }
     }
-    let not_from_end_of = |sfx: &str| !cut(&not_from_end, sfx).is_empty();
     let all_colours = (!vocab.colours.is_empty()).then_some("qcolour");
     let all_regions = (!keys.is_empty()).then_some("qregion");
     let shared_not_from_end = !not_from_end.is_empty();
@@ -1575,7 +1577,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 group,
                 (all_colours, all_regions),
                 vocab,
-                not_from_end_of(group.orders()),
+                !group.orders_of(&not_from_end).is_empty(),
                 (groups.as_deref().unwrap_or_default(), &get),
             );
         }

@@ -252,14 +252,14 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
             let known = check::known_colours(ctx.map, &ctx.references, ctx.earlier.as_deref());
             narrow_exclusions(v, instruction, &known);
         }
-        if ctx.options.directions_of_said && ctx.earlier.is_none() {
-            narrow_directions(v, ctx.map, instruction, ctx.pose());
-        }
-        if ctx.options.counts_of_said && ctx.earlier.is_none() {
-            narrow_counts(v, ctx.map, instruction, ctx.pose());
-        }
-        if ctx.options.far_ends_of_said && ctx.earlier.is_none() {
-            narrow_far_ends(v, ctx.map, instruction, ctx.pose());
+        for (on, what) in [
+            (ctx.options.directions_of_said, check::SaidOf::Direction),
+            (ctx.options.counts_of_said, check::SaidOf::Count),
+            (ctx.options.far_ends_of_said, check::SaidOf::FarEnd),
+        ] {
+            if on && ctx.earlier.is_none() {
+                narrow_said_of(v, ctx.map, instruction, ctx.pose(), what);
+            }
         }
         if ctx.options.side_stops_of_said && ctx.earlier.is_none() {
             narrow_side_stops(v, ctx.map, instruction, ctx.pose());
@@ -312,43 +312,40 @@ fn narrow_anchors(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str,
     v.anchors_of = Some(groups);
 }
 
-/// Offers the directional orders only to the names of the objects the person said a
-/// direction of ([`check::said_of_map`]: "the penultimate microscope, then
-/// the 2nd freezer counting from the west" counts the freezer from the west, not the
-/// microscope), each under all of its names. Nothing narrows where the instruction
-/// names no direction ([`narrow_orders`] then offers none) or where the clause that
-/// names one names no object and no other clause names one. Held-out v8 (dev since its
-/// third run, read per task at stop 64): in hr04 and ht04 the default model counted an
-/// object in the order said of the next one.
-fn narrow_directions(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str, pose: Pose) {
-    if let Some(labels) = check::said_of_map(map, instruction, pose, check::SaidOf::Direction) {
-        v.directions_of = Some(names_of_labels(v, map, &labels, pose));
-    }
-}
-
-/// Offers ordinals of two or more (either end) only to the names of the objects the
-/// person said a count of ([`check::said_of_map`]: "piano, purple costume rack,
-/// 2nd stool from the west" counts the stool, not the costume rack), each under all of
-/// its names; the others count 1 or -1 ("the first", "the last" are said in too many
-/// ways to place). As [`narrow_directions`], nothing narrows where no count is said or
-/// none can be placed. Held-out v8 (dev since its third run) ht12: the default model
-/// wrote the stool's 2 on the costume rack.
-fn narrow_counts(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str, pose: Pose) {
-    if let Some(labels) = check::said_of_map(map, instruction, pose, check::SaidOf::Count) {
-        v.counts_of = Some(names_of_labels(v, map, &labels, pose));
-    }
-}
-
-/// Offers `far_to_near` only to the names of the objects the person spoke of the far end
-/// of ([`check::said_of_map`]: "the second-to-last luggage trolley, then the green table
-/// in the cafe" counts the trolley from the far end, not the table), each under all of
-/// its names. As [`narrow_directions`], nothing narrows where no far end is said
-/// ([`narrow_orders`] then offers no `far_to_near`) or where none can be placed.
-/// Held-out v9 (dev since its third run, read per task at stop 67) hv04: the default
-/// model picked the green table `far_to_near`, a wrong stop no check saw.
-fn narrow_far_ends(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str, pose: Pose) {
-    if let Some(labels) = check::said_of_map(map, instruction, pose, check::SaidOf::FarEnd) {
-        v.far_ends_of = Some(names_of_labels(v, map, &labels, pose));
+/// Offers what `what` selects with only to the names of the objects the person said it
+/// of ([`check::said_of_map`]), each under all of its names; nothing narrows where the
+/// instruction does not say it ([`narrow_orders`] and [`said_ordinals`] then offer none)
+/// or where the clause that says it names no object and no other clause names one.
+/// - [`check::SaidOf::Direction`], the directional orders
+///   ([`Vocabulary::directions_of`]): "the penultimate microscope, then the 2nd freezer
+///   counting from the west" counts the freezer from the west, not the microscope.
+///   Held-out v8 (dev since its third run, read per task at stop 64): in hr04 and ht04
+///   the default model counted an object in the order said of the next one.
+/// - [`check::SaidOf::Count`], ordinals of two or more from either end
+///   ([`Vocabulary::counts_of`]; the others count 1 or -1: "the first", "the last" are
+///   said in too many ways to place): "piano, purple costume rack, 2nd stool from the
+///   west" counts the stool, not the costume rack. Held-out v8 (dev) ht12: the default
+///   model wrote the stool's 2 on the costume rack.
+/// - [`check::SaidOf::FarEnd`], `far_to_near` ([`Vocabulary::far_ends_of`]): "the
+///   second-to-last luggage trolley, then the green table in the cafe" counts the
+///   trolley from the far end, not the table. Held-out v9 (dev since its third run, read
+///   per task at stop 67) hv04: the default model picked the green table `far_to_near`,
+///   a wrong stop no check saw.
+fn narrow_said_of(
+    v: &mut Vocabulary,
+    map: &map_core::IvlMap,
+    instruction: &str,
+    pose: Pose,
+    what: check::SaidOf,
+) {
+    let Some(labels) = check::said_of_map(map, instruction, pose, what) else {
+        return;
+    };
+    let names = Some(names_of_labels(v, map, &labels, pose));
+    match what {
+        check::SaidOf::Direction => v.directions_of = names,
+        check::SaidOf::Count => v.counts_of = names,
+        check::SaidOf::FarEnd => v.far_ends_of = names,
     }
 }
 
