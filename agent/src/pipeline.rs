@@ -171,6 +171,14 @@ pub struct PlanOptions {
     /// given from the first answer on (default off until judged; `--said-colours-required`).
     /// Outside a conversation only.
     pub said_colours_required: bool,
+    /// The re-ask keeps what no finding disputes (default on; `--reask-whole` turns it
+    /// off): where every finding is about a step of the plan (`check::Finding::about`),
+    /// the re-ask's answer begins with the first answer's objects line and its steps
+    /// before the first disputed one, as the model wrote them, and the model writes the
+    /// rest under the re-ask's grammar (`v2::held_answer`). The checks judge the whole
+    /// answer as any other. Measured on held-out v9 (dev, stop 68): re-asks that mended
+    /// their finding broke a step no finding was about (a count, a colour, a room).
+    pub reask_holds_agreed: bool,
 }
 
 impl Default for PlanOptions {
@@ -200,6 +208,7 @@ impl Default for PlanOptions {
             reversed_draw: true,
             follow_objects: false,
             said_colours_required: false,
+            reask_holds_agreed: true,
         }
     }
 }

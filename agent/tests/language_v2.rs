@@ -139,6 +139,54 @@ fn a_disagreement_gets_one_targeted_reask() {
 }
 
 #[test]
+fn a_reask_keeps_the_steps_before_the_first_disputed_one() {
+    let instruction = "go to the kitchen, then to the black sofa";
+    let first = "objects: [(kitchen, None, None), (sofa, None, black)]\nplan:\nmove_to_object(\"kitchen\");\nmove_to_object(get_obj(\"sofa\"));\n";
+    let kept = "objects: [(kitchen, None, None), (sofa, None, black)]\nplan:\nmove_to_object(\"kitchen\");\n";
+    // The model writes only what follows the kept step.
+    let rest = "move_to_object(get_obj(\"sofa\", #{colour: \"black\"}));";
+    let (out, reqs) = plan_scripted(&[first, rest], instruction);
+    let p = out.plan().expect("a plan after the re-ask");
+    assert_eq!(p.source, PlanSource::Llm { repairs: 1 });
+    assert_eq!(p.attempts[1], format!("{kept}{rest}"));
+    assert!(p.script.contains("\"kitchen\"") && p.script.contains("colour: \"black\""));
+    // The re-ask: the findings in the request, the kept part as the answer's beginning,
+    // and the grammar of the plan's statements alone (no objects line).
+    assert_eq!(reqs.len(), 2);
+    let msgs = &reqs[1].messages;
+    assert_eq!(msgs.len(), reqs[0].messages.len() + 1);
+    assert_eq!(msgs.last().unwrap().role, Role::Assistant);
+    assert_eq!(msgs.last().unwrap().content, kept);
+    assert!(msgs[msgs.len() - 2].content.contains("\"black\""));
+    let g = reqs[1].grammar.as_deref().unwrap();
+    assert!(reqs[0].grammar.as_deref().unwrap().contains("objects"));
+    assert!(!g.contains("objects"), "{g}");
+    // The checks judge the whole answer: a continuation that disputes the kept step's
+    // words still goes on to the next draw, which writes a whole answer again.
+    let wrong = "move_to_object(get_obj(\"sofa\"));";
+    let right = "objects: [(kitchen, None, None), (sofa, None, black)]\nplan:\nmove_to_object(\"kitchen\");\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\n";
+    let (out, reqs) = plan_scripted(&[first, wrong, right], instruction);
+    assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 2 });
+    assert_eq!(reqs[2].messages.last().unwrap().role, Role::User);
+    // Where the first step is disputed, nothing is kept.
+    let first_wrong = "objects: [(sofa, None, black), (kitchen, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\nmove_to_object(\"kitchen\");\n";
+    let whole = "objects: [(sofa, None, black), (kitchen, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_object(\"kitchen\");\n";
+    let (out, reqs) = plan_scripted(&[first_wrong, whole], "the black sofa, then the kitchen");
+    assert!(out.plan().is_some());
+    assert_eq!(reqs[1].messages.len(), reqs[0].messages.len());
+    // `--reask-whole`: the re-ask writes the whole answer again.
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let b = Scripted::new(&[first, right]);
+    let mut ctx = v2(&map, &robot);
+    ctx.options.reask_holds_agreed = false;
+    let out = plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
+    assert!(out.plan().is_some());
+    let reqs = b.requests();
+    assert_eq!(reqs[1].messages.len(), reqs[0].messages.len());
+}
+
+#[test]
 fn asked_to_come_back_the_grammar_requires_a_move_back_and_a_plan_without_one_is_reasked() {
     let no_return = BLACK_SOFA_RIGHT;
     let with_return = "objects: [(sofa, None, black)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_start();\n";

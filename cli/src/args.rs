@@ -303,6 +303,10 @@ pub(crate) struct ModelArgs {
     /// after a missing side move (off by default: measured worse on held-out v9, dev).
     #[arg(long)]
     pub(crate) side_stops_barred: bool,
+    /// Let the re-ask write its whole answer again, not only from the first step a
+    /// finding disputes (the default before stop 69; for comparison).
+    #[arg(long)]
+    pub(crate) reask_whole: bool,
     /// Let a pick be picked near any object, not only one the person named in a clause
     /// with it (the default before stop 67; for comparison).
     #[arg(long)]
@@ -382,6 +386,7 @@ impl ModelArgs {
             counts_of_said: !self.counts_anywhere,
             far_ends_of_said: !self.far_end_anywhere,
             side_stops_of_said: self.side_stops_barred,
+            reask_holds_agreed: !self.reask_whole,
             pairs_of_said: !self.pairs_anywhere,
             orders_of_said: !self.any_direction,
             anchors_of_said: !self.anchors_anywhere,

@@ -176,7 +176,12 @@ fn assess(text: &str, instruction: &str, ctx: &PlanContext<'_>) -> Result<Accept
             }
             if let Some(e) = d.outcome.error {
                 let line = script.lines().nth(e.span.line.wrapping_sub(1));
-                run_error = Some(runtime_finding(&e.message, line));
+                let mut f = runtime_finding(&e.message, line);
+                // The script prints one step a line.
+                if let Some(step) = e.span.line.checked_sub(1) {
+                    f = f.at_step(step);
+                }
+                run_error = Some(f);
             }
         }
     }
@@ -691,6 +696,8 @@ pub fn plan_instruction(
     let mut attempts = Vec::new();
     let mut findings = Vec::new();
     let draws = draws(&ctx.options);
+    // What the re-ask keeps of the first answer (`PlanOptions::reask_holds_agreed`).
+    let mut held: Option<Held> = None;
     for (round, draw) in draws.iter().enumerate() {
         let round = u32::try_from(round).unwrap_or(u32::MAX);
         let mut req = CompletionRequest::new(
@@ -706,7 +713,12 @@ pub fn plan_instruction(
             req.temperature = ctx.options.redraw_temperature;
             req.seed = Some(*seed);
         }
-        let c = if follow {
+        let hold = matches!(draw, Draw::Reask)
+            .then_some(held.as_ref())
+            .flatten();
+        let c = if let Some(h) = hold {
+            held_answer(backend, &req, h, instruction, &current, ctx, &mut timing)?
+        } else if follow {
             answer_following_objects(backend, &req, instruction, &current, ctx, &mut timing)?
         } else {
             let c = backend.complete(&req)?;
@@ -749,6 +761,15 @@ pub fn plan_instruction(
                     (grammar, lark) = grammar_of(&v);
                     current = v;
                 }
+                if ctx.options.reask_holds_agreed {
+                    held = held_prefix(&c.text, &f, ctx);
+                    if let Some(h) = &held {
+                        tracing::debug!(
+                            steps = h.steps,
+                            "the re-ask keeps the steps before the first disputed one"
+                        );
+                    }
+                }
             }
             Some(_) => {
                 tracing::debug!(round, answer = %c.text, findings = ?f, "answer disagrees; drawing again");
@@ -757,6 +778,118 @@ pub fn plan_instruction(
         findings = f;
     }
     Ok(settle(&findings))
+}
+
+/// The beginning of the re-ask's answer that no finding disputes
+/// ([`crate::PlanOptions::reask_holds_agreed`]).
+#[derive(Debug, Clone, PartialEq)]
+struct Held {
+    /// The first answer's objects line, `plan:`, and its first `steps` statements (each
+    /// with the comment lines before it), as the model wrote them, ending in a newline.
+    prefix: String,
+    /// The objects line's tuples.
+    tuples: Vec<Tuple>,
+    /// How many steps it keeps.
+    steps: usize,
+    /// Whether a kept step moves back to the start.
+    returns: bool,
+}
+
+/// What the re-ask after `findings` keeps of the answer `text`: its objects line and its
+/// steps before the first one a finding is about ([`check::first_disputed_step`]), and
+/// never a `let` or what follows one (the plan grammar offers a variable only after
+/// its own `let`). `None` where a finding is about no one step or the objects line,
+/// where the first step is disputed, or where the text is not in the grammar's shape (objects line, `plan:`, a statement a
+/// line, comment lines before them).
+fn held_prefix(text: &str, findings: &[Finding], ctx: &PlanContext<'_>) -> Option<Held> {
+    let answer = parse_answer(text).ok()?;
+    let disputed = check::first_disputed_step(ctx.map, findings, &answer.plan, ctx.pose())?;
+    let steps = answer
+        .plan
+        .steps
+        .iter()
+        .take(disputed)
+        .position(|s| matches!(s, planner_dsl::typed::Step::Let { .. }))
+        .unwrap_or(disputed);
+    // With no step to keep, nothing is kept: the objects line alone is no agreed part
+    // (it may lack what the disputed first step lacks).
+    if steps == 0 {
+        return None;
+    }
+    let mut lines = text.lines();
+    let objects = lines.next()?;
+    if !objects.starts_with("objects:") || lines.next()? != "plan:" {
+        return None;
+    }
+    let body: Vec<&str> = lines.filter(|l| !l.trim().is_empty()).collect();
+    let statements = body
+        .iter()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .count();
+    if statements != answer.plan.steps.len() {
+        return None;
+    }
+    let mut prefix = format!("{objects}\nplan:\n");
+    let mut kept = 0;
+    for l in body {
+        if kept == steps {
+            break;
+        }
+        prefix.push_str(l);
+        prefix.push('\n');
+        if !l.trim_start().starts_with("//") {
+            kept += 1;
+        }
+    }
+    let returns = answer.plan.steps[..steps].iter().any(|s| {
+        matches!(
+            s,
+            planner_dsl::typed::Step::ToStart | planner_dsl::typed::Step::MoveTo(_)
+        )
+    });
+    Some(Held {
+        prefix,
+        tuples: answer.tuples,
+        steps,
+        returns,
+    })
+}
+
+/// The re-ask's answer to `req` begun with `held`: the model continues the plan after
+/// the kept steps under the plan's grammar of `vocab` (narrowed by the kept objects
+/// line where [`crate::PlanOptions::follow_objects`] is on; no move back required where
+/// a kept step makes it). The completion is the whole answer.
+fn held_answer(
+    backend: &dyn LlmBackend,
+    req: &CompletionRequest,
+    held: &Held,
+    instruction: &str,
+    vocab: &Vocabulary,
+    ctx: &PlanContext<'_>,
+    timing: &mut Timing,
+) -> Result<llm::Completion, LanguageError> {
+    let pose = ctx.pose();
+    let mut v = if ctx.options.follow_objects {
+        let said = check::colour_nouns(ctx.map, instruction, pose);
+        follow_objects(vocab, ctx.map, &held.tuples, &said, pose)
+    } else {
+        vocab.clone()
+    };
+    if held.returns {
+        v.return_required = false;
+    }
+    let mut r = req.clone();
+    r.messages.push(ChatMessage::assistant(held.prefix.clone()));
+    if ctx.options.answer_grammar {
+        r.grammar = Some(plan_grammar(&v));
+        r.lark = ctx.options.llguidance.then(|| plan_lark(&v));
+    }
+    let c = backend.complete(&r)?;
+    timing.add(&c);
+    Ok(llm::Completion {
+        text: format!("{}{}", held.prefix, c.text),
+        ..c
+    })
 }
 
 /// One answer to `req` in two requests: the objects line alone (the first part of the
