@@ -65,6 +65,10 @@ pub enum About {
     Label(String),
     /// The plan's step of this index (from 0): the dry run failed there.
     Step(usize),
+    /// An object or room of this map label that the person named and the plan never
+    /// picks: the steps for what the person named before it, in the order named, stand
+    /// ([`first_disputed_step`]).
+    Missing(String),
 }
 
 /// A form of the first answer that its re-ask's grammar bars, leaving the model every
@@ -164,44 +168,84 @@ impl Finding {
 }
 
 /// The index of the first step of `plan` that one of `findings` is about, where every
-/// finding is about some step ([`Finding::about`]) and is of the plan alone (not of the
-/// objects line, the map, or an answer that did not read): the steps before it are
-/// those no finding disputes. `None` where a finding is about no step (something the plan
-/// lacks), or a label it is about is in no step. A step picks a label when one of its
-/// targets (an anchor's too), its bare names or its instance ids are of that label.
+/// finding is about some place in the plan ([`Finding::about`]) and is of the plan alone
+/// (not of the map, or an answer that did not read; of the objects line only where it
+/// lists what the plan lacks): the steps before it are those no finding disputes.
+/// `None` where a finding is about no place (a missing move back, a "between" with no
+/// stop between), or a label it is about is in no step.
+///
+/// A step picks a label when one of its targets (an anchor's, a room's too), its bare
+/// names or its instance ids are of that label. For an object the plan lacks
+/// ([`About::Missing`]), the steps stand that pick, in order, what the person named
+/// before it, in the order named ([`name_mentions`]; design.md: the order of mention is
+/// the order of the visits), less the last of them, which the missing object may belong
+/// to ("the swivel chair closest to the white printer" written without the printer).
 #[must_use]
 pub fn first_disputed_step(
     map: &IvlMap,
+    instruction: &str,
     findings: &[Finding],
     plan: &TypedPlan,
     pose: Pose,
 ) -> Option<usize> {
-    let step_labels = |s: &Step| -> Vec<String> {
-        let mut out: Vec<String> = s
-            .targets()
-            .iter()
-            .filter_map(|t| label_of(map, &t.name, pose))
-            .collect();
-        out.extend(s.names().into_iter().filter_map(|n| label_of(map, n, pose)));
-        for o in s.objects() {
-            if let Object::Instance(id) = o {
-                out.extend(map.instance_by_id(*id).map(|i| i.label.clone()));
-            }
-        }
-        out
-    };
+    let labels = |s: &Step| step_labels(map, s, pose);
+    let mentions: Vec<String> = name_mentions(map, &words(instruction), pose)
+        .into_iter()
+        .map(|(_, l)| l)
+        .collect();
     let mut first: Option<usize> = None;
     for f in findings {
-        if !matches!(f.kind, FindingKind::Word | FindingKind::Runtime) {
-            return None;
+        let about = f.about.as_ref()?;
+        match (f.kind, about) {
+            (FindingKind::Word | FindingKind::Runtime, _)
+            | (FindingKind::Parts, About::Missing(_)) => {}
+            _ => return None,
         }
-        let at = match f.about.as_ref()? {
+        let at = match about {
             About::Step(i) => (*i < plan.steps.len()).then_some(*i)?,
-            About::Label(l) => plan.steps.iter().position(|s| step_labels(s).contains(l))?,
+            About::Label(l) => plan.steps.iter().position(|s| labels(s).contains(l))?,
+            About::Missing(l) => {
+                let named_at = mentions.iter().position(|m| m == l)?;
+                let mut m = 0;
+                let mut agreed: usize = 0;
+                for s in &plan.steps {
+                    let ls = labels(s);
+                    if ls.is_empty()
+                        || m + ls.len() > named_at
+                        || mentions[m..m + ls.len()] != ls[..]
+                    {
+                        break;
+                    }
+                    m += ls.len();
+                    agreed += 1;
+                }
+                if m == named_at {
+                    agreed.saturating_sub(1)
+                } else {
+                    agreed
+                }
+            }
         };
         first = Some(first.map_or(at, |k| k.min(at)));
     }
     first
+}
+
+/// The labels a step picks, in the order a person names them: each target's, then its
+/// room's (`region:`), then its anchors'; its bare names (rooms too); its instance ids'.
+fn step_labels(map: &IvlMap, s: &Step, pose: Pose) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for t in s.targets() {
+        out.extend(label_of(map, &t.name, pose));
+        out.extend(t.region.as_deref().and_then(|r| label_of(map, r, pose)));
+    }
+    out.extend(s.names().into_iter().filter_map(|n| label_of(map, n, pose)));
+    for o in s.objects() {
+        if let Object::Instance(id) = o {
+            out.extend(map.instance_by_id(*id).map(|i| i.label.clone()));
+        }
+    }
+    out
 }
 
 /// Whether two colour words name the same colour ("grey" and "gray").
@@ -466,14 +510,16 @@ fn check_tuples(
             }
         }
         if !accounted_for(map, &label, &used, visited, by_reference.then_some(refs)) {
-            out.push(Finding::new(
+            let mut f = Finding::new(
                 FindingKind::Parts,
                 format!(
                     "the objects line lists {} but the plan does not use a {label}",
                     t.paper_form()
                 ),
                 format!("I am not sure what to do with the {}", t.object),
-            ));
+            );
+            f.about = Some(About::Missing(label));
+            out.push(f);
         }
     }
     out
@@ -1196,6 +1242,18 @@ fn from_end(t: &Target, order: ObjectOrder) -> bool {
 /// word ("the two tables"). A two-word name takes its words: "coffee table" is not also
 /// a "table". Synonyms ("couch") are not read here, so they are never judged.
 fn said_names(map: &IvlMap, w: &[String]) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = Vec::new();
+    for (i, len, name) in names_at(map, w) {
+        if !out.iter().any(|(_, l)| *l == name) {
+            out.push((w[i..i + len].join(" "), name));
+        }
+    }
+    out
+}
+
+/// Each map name (label or region) the words `w` say, as [`said_names`] reads them, each
+/// time: where it begins, how many words it takes, the name.
+fn names_at(map: &IvlMap, w: &[String]) -> Vec<(usize, usize, String)> {
     let names: Vec<(String, Vec<String>)> = names_on_map(map)
         .into_iter()
         .map(|n| {
@@ -1211,7 +1269,7 @@ fn said_names(map: &IvlMap, w: &[String]) -> Vec<(String, String)> {
             && (w[at + n - 1] == ws[n - 1]
                 || w[at + n - 1] == map_core::matcher::plural(&ws[n - 1]))
     };
-    let mut out: Vec<(String, String)> = Vec::new();
+    let mut out = Vec::new();
     let mut i = 0;
     while i < w.len() {
         let best = names
@@ -1220,12 +1278,31 @@ fn said_names(map: &IvlMap, w: &[String]) -> Vec<(String, String)> {
             .max_by_key(|(_, ws)| ws.len());
         match best {
             Some((name, ws)) => {
-                if !out.iter().any(|(_, l)| l == name) {
-                    out.push((w[i..i + ws.len()].join(" "), name.clone()));
-                }
+                out.push((i, ws.len(), name.clone()));
                 i += ws.len();
             }
             None => i += 1,
+        }
+    }
+    out
+}
+
+/// Every map name the instruction's words `w` say, in order, each time, with the word
+/// where it begins: the names and rooms of [`names_at`], and the objects' synonyms where
+/// no name is ([`label_at`]: "telly" is the tv).
+pub(crate) fn name_mentions(map: &IvlMap, w: &[String], pose: Pose) -> Vec<(usize, String)> {
+    let exact = names_at(map, w);
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < w.len() {
+        if let Some((_, len, name)) = exact.iter().find(|(i, _, _)| *i == k) {
+            out.push((k, name.clone()));
+            k += len;
+        } else if let Some((_, label, len)) = label_at(map, w, k, pose) {
+            out.push((k, label));
+            k += len;
+        } else {
+            k += 1;
         }
     }
     out
@@ -1258,11 +1335,13 @@ fn check_names(
             } else {
                 format!("the person said \"{said}\", but the plan neither goes to nor uses a {label}: pick it with get_obj(\"{label}\", ...) where the person wants it")
             };
-            out.push(Finding::new(
+            let mut f = Finding::new(
                 FindingKind::Word,
                 to_model,
                 format!("what should I do with the {said}?"),
-            ));
+            );
+            f.about = Some(About::Missing(label));
+            out.push(f);
         }
     }
     out
@@ -3073,7 +3152,7 @@ pub(crate) mod tests {
             let a = parse_answer(answer).unwrap();
             let f = check_answer(&m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[]);
             assert!(!f.is_empty(), "{instruction}: no finding");
-            first_disputed_step(&m, &f, &a.plan, m.start_pose)
+            first_disputed_step(&m, instruction, &f, &a.plan, m.start_pose)
         };
         // A colour dropped from the sofa, the second step: the kitchen before it stands.
         let sofa = "objects: [(kitchen, None, None), (sofa, None, black)]\nplan:\nmove_to_object(\"kitchen\");\nmove_to_object(get_obj(\"sofa\"));";
@@ -3094,24 +3173,53 @@ pub(crate) mod tests {
         let a = parse_answer(sofa).unwrap();
         let parts = Finding::new(FindingKind::Parts, "", "").about_label(Some("sofa".into()));
         assert_eq!(
-            first_disputed_step(&m, &[parts], &a.plan, m.start_pose),
+            first_disputed_step(&m, "", &[parts], &a.plan, m.start_pose),
             None
         );
         // The dry run's step, and the earliest of several places.
         let run = runtime_finding("no such sofa", None).at_step(1);
         let word = Finding::new(FindingKind::Word, "", "").about_label(Some("kitchen".into()));
         assert_eq!(
-            first_disputed_step(&m, std::slice::from_ref(&run), &a.plan, m.start_pose),
+            first_disputed_step(&m, "", std::slice::from_ref(&run), &a.plan, m.start_pose),
             Some(1)
         );
         assert_eq!(
-            first_disputed_step(&m, &[run, word], &a.plan, m.start_pose),
+            first_disputed_step(&m, "", &[run, word], &a.plan, m.start_pose),
             Some(0)
+        );
+        // An object the plan lacks: the steps for what was named before it stand, in the
+        // order named, less the last (the kitchen named after the table and the chair:
+        // the table stands; the chair may be where the kitchen was meant to go).
+        let no_kitchen = "objects: [(table, None, None), (chair, None, None), (kitchen, None, None)]\nplan:\nmove_to_object(get_obj(\"table\"));\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"sofa\"));";
+        assert_eq!(
+            first("the table, then the chair, then the kitchen", no_kitchen),
+            Some(1)
+        );
+        // Named out of the plan's order: nothing stands.
+        assert_eq!(
+            first("the chair, then the table, then the kitchen", no_kitchen),
+            Some(0)
+        );
+        // A missing anchor said with the first stop: nothing stands.
+        let no_anchor = "objects: [(chair, None, None), (kitchen, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(\"kitchen\");";
+        assert_eq!(
+            first("the chair closest to the sofa, then the kitchen", no_anchor),
+            Some(0)
+        );
+        // A synonym and a room picked with `region:` are named as said ("the telly",
+        // "the table in the kitchen").
+        let tv = "objects: [(telly, None, None), (table, None, None), (chair, None, None), (bed, None, None)]\nplan:\nmove_to_object(get_obj(\"tv\"));\nmove_to_object(get_obj(\"table\", #{region: \"kitchen\"}));\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"sofa\"));";
+        assert_eq!(
+            first(
+                "the telly, the table in the kitchen, the chair, then the bed",
+                tv
+            ),
+            Some(2)
         );
         // A step past the plan's end is no place in it.
         let past = runtime_finding("x", None).at_step(5);
         assert_eq!(
-            first_disputed_step(&m, &[past], &a.plan, m.start_pose),
+            first_disputed_step(&m, "", &[past], &a.plan, m.start_pose),
             None
         );
     }

@@ -762,7 +762,7 @@ pub fn plan_instruction(
                     current = v;
                 }
                 if ctx.options.reask_holds_agreed {
-                    held = held_prefix(&c.text, &f, ctx);
+                    held = held_prefix(&c.text, instruction, &f, ctx);
                     if let Some(h) = &held {
                         tracing::debug!(
                             steps = h.steps,
@@ -801,9 +801,15 @@ struct Held {
 /// its own `let`). `None` where a finding is about no one step or the objects line,
 /// where the first step is disputed, or where the text is not in the grammar's shape (objects line, `plan:`, a statement a
 /// line, comment lines before them).
-fn held_prefix(text: &str, findings: &[Finding], ctx: &PlanContext<'_>) -> Option<Held> {
+fn held_prefix(
+    text: &str,
+    instruction: &str,
+    findings: &[Finding],
+    ctx: &PlanContext<'_>,
+) -> Option<Held> {
     let answer = parse_answer(text).ok()?;
-    let disputed = check::first_disputed_step(ctx.map, findings, &answer.plan, ctx.pose())?;
+    let disputed =
+        check::first_disputed_step(ctx.map, instruction, findings, &answer.plan, ctx.pose())?;
     let steps = answer
         .plan
         .steps
