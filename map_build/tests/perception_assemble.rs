@@ -111,8 +111,13 @@ fn example_scenes_build_back_from_perfect_perception() {
             );
             // the contour (hull of the cells) holds the object's footprint and
             // does not stray more than a cell from it
+            // A footprint's corner may fall between cell centres: a right angle cuts
+            // in by up to about three quarters of a cell, a corner of a square turned
+            // 45 degrees (ferry-ab's helm, a diamond whose tips sit on a cell edge) by
+            // up to a cell.
             for &v in want.contour.vertices() {
-                assert!(got.contour.distance(v) < 0.75 * cs, "{at}: {v:?}");
+                let d = got.contour.distance(v);
+                assert!(d < cs, "{at}: {v:?} is {d} m from the cells' hull");
             }
             for &v in got.contour.vertices() {
                 assert!(want.contour.distance(v) < 1.5 * cs, "{at}: {v:?}");
