@@ -159,6 +159,13 @@ impl Finding {
         self
     }
 
+    /// Placed after the steps for what was named before `label`, which the plan lacks
+    /// (see [`About::Missing`]).
+    fn missing(mut self, label: String) -> Self {
+        self.about = Some(About::Missing(label));
+        self
+    }
+
     /// Placed at the plan's step `index` (see [`About::Step`]).
     #[must_use]
     pub fn at_step(mut self, index: usize) -> Self {
@@ -308,22 +315,12 @@ fn targets(plan: &TypedPlan) -> Vec<&Target> {
     plan.steps.iter().flat_map(Step::targets).collect()
 }
 
-/// The labels the plan names, once per mention (targets and bare names).
+/// The labels the plan names, once per mention, step by step ([`step_labels`]).
 fn plan_labels(map: &IvlMap, plan: &TypedPlan, pose: Pose) -> Vec<String> {
-    let mut out: Vec<String> = Vec::new();
-    for t in targets(plan) {
-        out.extend(label_of(map, &t.name, pose));
-        out.extend(t.region.as_deref().and_then(|r| label_of(map, r, pose)));
-    }
-    for s in &plan.steps {
-        out.extend(s.names().into_iter().filter_map(|n| label_of(map, n, pose)));
-        for o in s.objects() {
-            if let planner_dsl::typed::Object::Instance(id) = o {
-                out.extend(map.instance_by_id(*id).map(|i| i.label.clone()));
-            }
-        }
-    }
-    out
+    plan.steps
+        .iter()
+        .flat_map(|s| step_labels(map, s, pose))
+        .collect()
 }
 
 /// A short list of what the map holds of `label`, for questions: "3 chairs (2 black, 1 red)".
@@ -510,7 +507,7 @@ fn check_tuples(
             }
         }
         if !accounted_for(map, &label, &used, visited, by_reference.then_some(refs)) {
-            let mut f = Finding::new(
+            let f = Finding::new(
                 FindingKind::Parts,
                 format!(
                     "the objects line lists {} but the plan does not use a {label}",
@@ -518,8 +515,7 @@ fn check_tuples(
                 ),
                 format!("I am not sure what to do with the {}", t.object),
             );
-            f.about = Some(About::Missing(label));
-            out.push(f);
+            out.push(f.missing(label));
         }
     }
     out
@@ -1335,13 +1331,12 @@ fn check_names(
             } else {
                 format!("the person said \"{said}\", but the plan neither goes to nor uses a {label}: pick it with get_obj(\"{label}\", ...) where the person wants it")
             };
-            let mut f = Finding::new(
+            let f = Finding::new(
                 FindingKind::Word,
                 to_model,
                 format!("what should I do with the {said}?"),
             );
-            f.about = Some(About::Missing(label));
-            out.push(f);
+            out.push(f.missing(label));
         }
     }
     out
@@ -1797,7 +1792,12 @@ fn check_two_guessed(
 /// (`move_to([x, y])`, which a conversation's "where we started" is): the steps of
 /// `grammar::RETURN_FUNCTIONS`, which the grammar requires.
 pub(crate) fn plan_returns(plan: &TypedPlan) -> bool {
-    plan.steps
+    steps_return(&plan.steps)
+}
+
+/// Whether one of `steps` moves back to where the plan began (see [`plan_returns`]).
+pub(crate) fn steps_return(steps: &[Step]) -> bool {
+    steps
         .iter()
         .any(|s| matches!(s, Step::ToStart | Step::MoveTo(_)))
 }

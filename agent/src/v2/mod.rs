@@ -799,8 +799,8 @@ struct Held {
 /// steps before the first one a finding is about ([`check::first_disputed_step`]), and
 /// never a `let` or what follows one (the plan grammar offers a variable only after
 /// its own `let`). `None` where a finding is about no one step or the objects line,
-/// where the first step is disputed, or where the text is not in the grammar's shape (objects line, `plan:`, a statement a
-/// line, comment lines before them).
+/// where the first step is disputed, or where the text is not in the grammar's shape
+/// (objects line, `plan:`, a statement a line, comment lines before them).
 fn held_prefix(
     text: &str,
     instruction: &str,
@@ -847,12 +847,7 @@ fn held_prefix(
             kept += 1;
         }
     }
-    let returns = answer.plan.steps[..steps].iter().any(|s| {
-        matches!(
-            s,
-            planner_dsl::typed::Step::ToStart | planner_dsl::typed::Step::MoveTo(_)
-        )
-    });
+    let returns = check::steps_return(&answer.plan.steps[..steps]);
     Some(Held {
         prefix,
         tuples: answer.tuples,
@@ -862,9 +857,9 @@ fn held_prefix(
 }
 
 /// The re-ask's answer to `req` begun with `held`: the model continues the plan after
-/// the kept steps under the plan's grammar of `vocab` (narrowed by the kept objects
-/// line where [`crate::PlanOptions::follow_objects`] is on; no move back required where
-/// a kept step makes it). The completion is the whole answer.
+/// the kept steps ([`continue_plan`]; the grammar narrowed by the kept objects line
+/// where [`crate::PlanOptions::follow_objects`] is on; no move back required where a
+/// kept step makes it).
 fn held_answer(
     backend: &dyn LlmBackend,
     req: &CompletionRequest,
@@ -874,36 +869,62 @@ fn held_answer(
     ctx: &PlanContext<'_>,
     timing: &mut Timing,
 ) -> Result<llm::Completion, LanguageError> {
-    let pose = ctx.pose();
     let mut v = if ctx.options.follow_objects {
-        let said = check::colour_nouns(ctx.map, instruction, pose);
-        follow_objects(vocab, ctx.map, &held.tuples, &said, pose)
+        narrowed_by_objects(vocab, &held.tuples, instruction, ctx)
     } else {
         vocab.clone()
     };
     if held.returns {
         v.return_required = false;
     }
+    continue_plan(backend, req, held.prefix.clone(), &v, ctx, timing)
+}
+
+/// The answer to `req` continued after `prefix`, the start of the assistant's turn (an
+/// objects line, `plan:`, any kept steps), under the plan's grammar of `v` where answer
+/// grammars are on. The completion is the whole answer; its counts and times are the
+/// continuation's.
+fn continue_plan(
+    backend: &dyn LlmBackend,
+    req: &CompletionRequest,
+    prefix: String,
+    v: &Vocabulary,
+    ctx: &PlanContext<'_>,
+    timing: &mut Timing,
+) -> Result<llm::Completion, LanguageError> {
     let mut r = req.clone();
-    r.messages.push(ChatMessage::assistant(held.prefix.clone()));
+    r.messages.push(ChatMessage::assistant(prefix.clone()));
     if ctx.options.answer_grammar {
-        r.grammar = Some(plan_grammar(&v));
-        r.lark = ctx.options.llguidance.then(|| plan_lark(&v));
+        r.grammar = Some(plan_grammar(v));
+        r.lark = ctx.options.llguidance.then(|| plan_lark(v));
     }
     let c = backend.complete(&r)?;
     timing.add(&c);
     Ok(llm::Completion {
-        text: format!("{}{}", held.prefix, c.text),
+        text: format!("{prefix}{}", c.text),
         ..c
     })
 }
 
+/// `vocab` narrowed by the objects line `tuples` ([`follow_objects`], with the colours
+/// the person said right before names).
+fn narrowed_by_objects(
+    vocab: &Vocabulary,
+    tuples: &[Tuple],
+    instruction: &str,
+    ctx: &PlanContext<'_>,
+) -> Vocabulary {
+    let pose = ctx.pose();
+    let said = check::colour_nouns(ctx.map, instruction, pose);
+    follow_objects(vocab, ctx.map, tuples, &said, pose)
+}
+
 /// One answer to `req` in two requests: the objects line alone (the first part of the
 /// answer's grammar, from `vocab`), then, continuing that text after `plan:`, the plan
-/// under the grammar [`follow_objects`] narrows by it. The completion is the whole
-/// answer, its token counts and times the two requests' sums. A backend that ignored the
-/// first grammar and wrote a plan already, or an objects line that does not read, gives
-/// that first text as the answer.
+/// under the grammar [`follow_objects`] narrows by it ([`continue_plan`]). The
+/// completion is the whole answer, its token counts and times the two requests' sums. A
+/// backend that ignored the first grammar and wrote a plan already, or an objects line
+/// that does not read, gives that first text as the answer.
 fn answer_following_objects(
     backend: &dyn LlmBackend,
     req: &CompletionRequest,
@@ -912,10 +933,9 @@ fn answer_following_objects(
     ctx: &PlanContext<'_>,
     timing: &mut Timing,
 ) -> Result<llm::Completion, LanguageError> {
-    let lark = ctx.options.llguidance;
     let mut first = req.clone();
     first.grammar = Some(answer_objects_grammar(vocab));
-    first.lark = lark.then(|| answer_objects_lark(vocab));
+    first.lark = ctx.options.llguidance.then(|| answer_objects_lark(vocab));
     let c1 = backend.complete(&first)?;
     timing.add(&c1);
     let tuples = objects_part(&c1.text).and_then(|(_, t)| parse_tuples(t).ok());
@@ -927,26 +947,19 @@ fn answer_following_objects(
     ) else {
         return Ok(c1);
     };
-    let pose = ctx.pose();
-    let said = check::colour_nouns(ctx.map, instruction, pose);
-    let narrowed = follow_objects(vocab, ctx.map, &tuples, &said, pose);
+    let narrowed = narrowed_by_objects(vocab, &tuples, instruction, ctx);
     let prefix = format!("{}\nplan:\n", c1.text.trim_end());
     let mut second = req.clone();
     second.max_tokens = room;
-    second.messages.push(ChatMessage::assistant(prefix.clone()));
-    second.grammar = Some(plan_grammar(&narrowed));
-    second.lark = lark.then(|| plan_lark(&narrowed));
-    let c2 = backend.complete(&second)?;
-    timing.add(&c2);
+    let c2 = continue_plan(backend, &second, prefix, &narrowed, ctx, timing)?;
     Ok(llm::Completion {
-        text: format!("{prefix}{}", c2.text),
         prompt_tokens: c1.prompt_tokens + c2.prompt_tokens,
         cached_prompt_tokens: c1.cached_prompt_tokens + c2.cached_prompt_tokens,
         completion_tokens: c1.completion_tokens + c2.completion_tokens,
         prompt_ms: c1.prompt_ms + c2.prompt_ms,
         generate_ms: c1.generate_ms + c2.generate_ms,
-        finish_reason: c2.finish_reason,
         forced_tokens: c1.forced_tokens + c2.forced_tokens,
+        ..c2
     })
 }
 
