@@ -492,13 +492,27 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
         (!orders.is_empty()).then_some((rule, orders))
     };
     let mut order_rules: Vec<(String, Vec<&str>)> = Vec::new();
+    // Where no far end is said of a class (`far_end` false), its "last" (-1 of the
+    // default order, the farthest) comes only with an order (`"last"` alone is left out
+    // of its ordinal rule, suffix `p`), as in the plan's picks
+    // ([`SelKeys::negative_needs_order`]).
+    let last = ordinal_signs(vocab).1;
     let mut tuple = |word: &str, c: (bool, bool, bool)| {
-        let ordinal = if c.1 { "tordinal" } else { "tordinal1" };
+        let ordinal = format!(
+            "{}{}",
+            if c.1 { "tordinal" } else { "tordinal1" },
+            if c.2 || !last { "" } else { "p" }
+        );
         match order_rule(c) {
             None => format!("\"(\" {word} \", \" {ordinal} \", \" tcolour \")\""),
             Some((rule, orders)) => {
-                let out =
+                let mut out =
                     format!("\"(\" {word} \", \" {ordinal} \", \" tcolour (\", \" {rule})? \")\"");
+                if !c.2 && last {
+                    out.push_str(&format!(
+                        " | \"(\" {word} \", last, \" tcolour \", \" {rule} \")\""
+                    ));
+                }
                 if !order_rules.iter().any(|(r, _)| *r == rule) {
                     order_rules.push((rule, orders));
                 }
@@ -591,6 +605,13 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
     w.rule("tordinal", &format!("\"None\"{last} | {n}"));
     if vocab.counts_of.is_some() {
         w.rule("tordinal1", &format!("\"None\"{last} | \"1\""));
+    }
+    // Less "last", for the classes no far end is said of.
+    if vocab.far_ends_of.is_some() && !last.is_empty() {
+        w.rule("tordinalp", &format!("\"None\" | {n}"));
+        if vocab.counts_of.is_some() {
+            w.rule("tordinal1p", "\"None\" | \"1\"");
+        }
     }
     let tcolours: Vec<&String> = match &vocab.tuple_colours {
         Some(offered) => colours.iter().filter(|c| offered.contains(c)).collect(),
@@ -735,6 +756,15 @@ struct SelKeys<'a> {
     positive: bool,
     negative: bool,
     not_from_end: bool,
+    /// A negative ordinal comes only with an order of `qordern` (the map does not end
+    /// between them): where no far end is said of the picks' object
+    /// ([`PickGroup::no_far_end`]), -1 of the default order (the farthest) is not what
+    /// the person said, and that group's `qordern` leaves out `near_to_far`
+    /// ([`PickGroup::order_ends`]). Held-out v10 (dev since its third run) ka03: "the
+    /// medicine cabinet that's furthest from you, then the water cooler, then the telly"
+    /// was planned with `ordinal: -1` for all three, a wrong stop at the water cooler
+    /// that no check saw.
+    negative_needs_order: bool,
     /// The map ends only after a `colour:` key (only with `colour`).
     colour_required: bool,
     /// The map ends only after a `colour:` or `not_colour:` key (only with `colour`).
@@ -755,6 +785,7 @@ impl SelKeys<'_> {
     fn may_end(&self, s: SelState) -> bool {
         (!self.colour_required || s.written & KEY_COLOUR != 0)
             && (!self.colour_key_required || s.written & (KEY_COLOUR | KEY_NOT_COLOUR) != 0)
+            && !(self.negative_needs_order && s.pending == Pending::OrderFromEnd)
     }
 
     /// The keys that may come next in `s`, each as its text and the state after it.
@@ -873,7 +904,7 @@ fn selection_rules(
     (colour, not_colour): (Option<&str>, Option<&str>),
     (region, near): (Option<&str>, Option<&str>),
     vocab: &Vocabulary,
-    not_from_end: bool,
+    ends: OrderEnds,
     (colour_required, colour_key_required, orders, no_counts): (bool, bool, &str, bool),
 ) {
     let (positive, negative) = ordinal_signs(vocab);
@@ -882,8 +913,9 @@ fn selection_rules(
         not_colour,
         region,
         positive,
-        negative,
-        not_from_end,
+        negative: negative && ends.negative,
+        not_from_end: ends.not_from_end,
+        negative_needs_order: ends.negative_needs_order,
         colour_required: colour_required && colour.is_some(),
         colour_key_required: colour_key_required && colour.is_some(),
         orders,
@@ -945,6 +977,17 @@ fn selection_rules(
     }
 }
 
+/// What the orders offered to a selection map allow of its ordinal ([`SelKeys`]).
+#[derive(Debug, Clone, Copy)]
+struct OrderEnds {
+    /// Some order is offered outside its `qordern` (rule `qorderf`).
+    not_from_end: bool,
+    /// A negative ordinal may be written (before the vocabulary's signs).
+    negative: bool,
+    /// A negative ordinal comes only with an order ([`SelKeys::negative_needs_order`]).
+    negative_needs_order: bool,
+}
+
 /// Names whose picks offer the same colours and regions. `None` in a list: all of the
 /// vocabulary's (the shared rule).
 #[derive(Debug, PartialEq)]
@@ -988,6 +1031,31 @@ impl PickGroup {
     /// The orders of `list` its picks may count in ([`orders_less`]).
     fn orders_of<'a>(&self, list: &[&'a str]) -> Vec<&'a str> {
         orders_less(list, self.no_directions, self.no_far_end)
+    }
+
+    /// Its orders a negative ordinal may count in (of `from_end`, its `qordern`) and
+    /// those after which an ordinal is positive (of `not_from_end`, its `qorderf`):
+    /// where no far end is said of it, the default order `near_to_far` is of the second
+    /// ([`SelKeys::negative_needs_order`]).
+    fn order_ends<'a>(
+        &self,
+        from_end: &[&'a str],
+        not_from_end: &[&'a str],
+    ) -> (Vec<&'a str>, Vec<&'a str>, OrderEnds) {
+        let mut ends = self.orders_of(from_end);
+        let mut rest = self.orders_of(not_from_end);
+        if self.no_far_end {
+            let near = ObjectOrder::NearToFar.name();
+            if let Some(k) = ends.iter().position(|o| *o == near) {
+                rest.push(ends.remove(k));
+            }
+        }
+        let flags = OrderEnds {
+            not_from_end: !rest.is_empty(),
+            negative: !self.no_far_end || !ends.is_empty(),
+            negative_needs_order: self.no_far_end,
+        };
+        (ends, rest, flags)
     }
 }
 
@@ -1156,7 +1224,7 @@ fn group_rules(
     group: &PickGroup,
     (all_colours, all_regions): (Option<&str>, Option<&str>),
     vocab: &Vocabulary,
-    not_from_end: bool,
+    ends: OrderEnds,
     (picks, get): (&[PickGroup], &str),
 ) {
     let near = match &group.anchors {
@@ -1210,7 +1278,7 @@ fn group_rules(
         (colours.as_deref(), not_colours.as_deref()),
         (regions.as_deref(), near.as_deref()),
         vocab,
-        not_from_end,
+        ends,
         (
             group.colour_required,
             group.colour_key_required,
@@ -1535,11 +1603,10 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         }
         written.push(sfx);
         w.rule(&format!("qorder{sfx}"), &alt(&g.orders_of(&offered), true));
-        w.rule(
-            &format!("qordern{sfx}"),
-            &alt(&g.orders_of(&from_end), true),
-        );
-        let rest = g.orders_of(&not_from_end);
+        let (ends, rest, _) = g.order_ends(&from_end, &not_from_end);
+        if !ends.is_empty() {
+            w.rule(&format!("qordern{sfx}"), &alt(&ends, true));
+        }
         if !rest.is_empty() {
             w.rule(&format!("qorderf{sfx}"), &alt(&rest, true));
         }
@@ -1565,7 +1632,11 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             (all_colours, all_colours),
             (all_regions, Some("objn")),
             vocab,
-            shared_not_from_end,
+            OrderEnds {
+                not_from_end: shared_not_from_end,
+                negative: true,
+                negative_needs_order: false,
+            },
             (false, false, "", false),
         );
     }
@@ -1577,7 +1648,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 group,
                 (all_colours, all_regions),
                 vocab,
-                !group.orders_of(&not_from_end).is_empty(),
+                group.order_ends(&from_end, &not_from_end).2,
                 (groups.as_deref().unwrap_or_default(), &get),
             );
         }

