@@ -134,6 +134,11 @@ pub struct PlanOptions {
     /// only an object the person named in a clause with it (`check::anchors_said`;
     /// default on; `--anchors-anywhere` turns it off).
     pub anchors_of_said: bool,
+    /// With `said_only`, outside a conversation: a pick takes no colour (kept or
+    /// excluded) that the person said only right before other objects' names
+    /// (`check::colour_said_only_of`: "the wheelchair closest to the blue hospital bed";
+    /// default on; `--colours-of-others-allowed` turns it off).
+    pub colours_of_others: bool,
     /// The objects line's colours are the person's (default on; `--any-tuple-colours`
     /// turns it off).
     pub said_tuple_colours: bool,
@@ -201,6 +206,7 @@ impl Default for PlanOptions {
             pairs_of_said: true,
             orders_of_said: true,
             anchors_of_said: true,
+            colours_of_others: true,
             said_tuple_colours: true,
             map_colours: true,
             redraws: 1,

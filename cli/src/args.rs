@@ -311,6 +311,10 @@ pub(crate) struct ModelArgs {
     /// with it (the default before stop 67; for comparison).
     #[arg(long)]
     pub(crate) anchors_anywhere: bool,
+    /// Let a pick take a colour the person said only of other objects (the default
+    /// before stop 70; for comparison).
+    #[arg(long)]
+    pub(crate) colours_of_others_allowed: bool,
     /// Let a tuple on the objects line carry any colour word, not only a colour the
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
@@ -390,6 +394,7 @@ impl ModelArgs {
             pairs_of_said: !self.pairs_anywhere,
             orders_of_said: !self.any_direction,
             anchors_of_said: !self.anchors_anywhere,
+            colours_of_others: !self.colours_of_others_allowed,
             said_tuple_colours: !self.any_tuple_colours,
             map_colours: !self.any_pick_colours,
             redraws: self.redraws,

@@ -603,6 +603,26 @@ fn colour_mentions(map: &IvlMap, instruction: &str, pose: Pose) -> Vec<(String, 
         .collect()
 }
 
+/// The labels a colour is said of, where every mention of it is right before a map
+/// object's name ([`colour_mentions`]; "the wheelchair closest to the blue hospital bed":
+/// blue, of the hospital bed); `None` where it is not said, or once said of no name.
+pub(crate) fn colour_said_only_of(
+    map: &IvlMap,
+    instruction: &str,
+    pose: Pose,
+) -> impl Fn(&str) -> Option<Vec<String>> {
+    let mentions = colour_mentions(map, instruction, pose);
+    move |c: &str| {
+        let c = canonical(c);
+        let labels: Option<Vec<String>> = mentions
+            .iter()
+            .filter(|(x, _)| *x == c)
+            .map(|(_, l)| l.clone())
+            .collect();
+        labels.filter(|l| !l.is_empty())
+    }
+}
+
 /// Each colour word of the instruction as [`colour_mentions`] reads it, read within its
 /// clause ([`clauses`]), and whether a word that excludes ([`excludes`]) comes before it
 /// there ("a stretcher that isn't green": excluded).
@@ -2318,8 +2338,9 @@ pub(crate) fn far_end_said(instruction: &str) -> bool {
     starts_a_word(instruction, FAR_END_STEMS)
 }
 
-/// The starts of words that speak of the far end ([`far_end_said`]).
-const FAR_END_STEMS: &[&str] = &["far", "furth", "distan", "last", "penult"];
+/// The starts of words that speak of the far end ([`far_end_said`]); "end" for "the
+/// third from the end", which counts from it.
+const FAR_END_STEMS: &[&str] = &["far", "furth", "distan", "last", "penult", "end"];
 
 /// Whether `word` starts as a word that speaks of the far end does ("most distant",
 /// "far away", "lastly"): the one reading [`far_end_said`] and [`ends_said_of_sides`]
@@ -2444,14 +2465,7 @@ fn check_colours_of_others(
     plan: &TypedPlan,
     pose: Pose,
 ) -> Vec<Finding> {
-    let mentions = colour_mentions(map, instruction, pose);
-    // The labels a colour is said of, where every mention of it is right before a name.
-    let said_only_of = |c: &str| -> Option<Vec<String>> {
-        let c = canonical(c);
-        let of: Vec<&(String, Option<String>)> = mentions.iter().filter(|(x, _)| *x == c).collect();
-        let labels: Option<Vec<String>> = of.iter().map(|(_, l)| l.clone()).collect();
-        labels.filter(|l| !l.is_empty())
-    };
+    let said_only_of = colour_said_only_of(map, instruction, pose);
     let mut out: Vec<Finding> = Vec::new();
     for t in targets(plan) {
         let Some(label) = object_label(map, &t.name, pose) else {
