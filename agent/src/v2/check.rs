@@ -166,6 +166,17 @@ impl Finding {
         self
     }
 
+    /// Placed at the step of `plan` that holds the target `t`, where one does (a
+    /// reference into `plan`): a finding about one pick disputes that step, not an
+    /// earlier pick of the same label ("the chair, then the red sofa, then the chair"
+    /// with red on the second chair).
+    fn at_target(self, plan: &TypedPlan, t: &Target) -> Self {
+        match step_of(plan, t) {
+            Some(i) => self.at_step(i),
+            None => self,
+        }
+    }
+
     /// Placed at the plan's step `index` (see [`About::Step`]).
     #[must_use]
     pub fn at_step(mut self, index: usize) -> Self {
@@ -2442,9 +2453,7 @@ fn check_unsaid_colours(
         if let Some(label) = label {
             f = f.barring(Bar::UnsaidColours { label });
         }
-        if !out.contains(&f) {
-            out.push(f);
-        }
+        push_first(&mut out, f.at_target(plan, t));
     }
     out
 }
@@ -2490,10 +2499,9 @@ fn check_colours_of_others(
                     describe_label(map, &label)
                 ),
             )
-            .barring(Bar::UnsaidColours { label });
-            if !out.contains(&f) {
-                out.push(f);
-            }
+            .barring(Bar::UnsaidColours { label })
+            .at_target(plan, t);
+            push_first(&mut out, f);
             break;
         }
     }
@@ -2584,6 +2592,7 @@ type Note<'a> = dyn Fn(&Target) -> String + 'a;
 fn unsaid_findings(
     map: &IvlMap,
     pose: Pose,
+    plan: &TypedPlan,
     targets: Vec<&Target>,
     to_model: impl Fn(&Target) -> String,
     to_user: impl Fn(&Target) -> String,
@@ -2595,12 +2604,27 @@ fn unsaid_findings(
             Some(l) => format!("{}? there are {}", to_user(t), describe_label(map, l)),
             None => format!("{}?", to_user(t)),
         };
-        let f = Finding::new(FindingKind::Word, to_model(t), question).about_label(label);
-        if !out.contains(&f) {
-            out.push(f);
-        }
+        let f = Finding::new(FindingKind::Word, to_model(t), question)
+            .about_label(label)
+            .at_target(plan, t);
+        push_first(&mut out, f);
     }
     out
+}
+
+/// Adds `f` unless a finding with its note to the model is there already: the first,
+/// the one at the earliest step of the plan, stands.
+fn push_first(out: &mut Vec<Finding>, f: Finding) {
+    if !out.iter().any(|x| x.to_model == f.to_model) {
+        out.push(f);
+    }
+}
+
+/// The index of the step of `plan` that holds the target `t` (a reference into it).
+fn step_of(plan: &TypedPlan, t: &Target) -> Option<usize> {
+    plan.steps
+        .iter()
+        .position(|s| s.targets().into_iter().any(|x| std::ptr::eq(x, t)))
 }
 
 /// Where the instruction names each map object (not a region): the word index of each
@@ -3104,13 +3128,14 @@ pub fn check_answer_after(
         ),
     ];
     for (targets, to_model, how) in unsaid {
-        out.extend(unsaid_findings(map, pose, targets, to_model, |t| {
+        out.extend(unsaid_findings(map, pose, plan, targets, to_model, |t| {
             format!("which {} do you mean{how}", t.name)
         }));
     }
     out.extend(unsaid_findings(
         map,
         pose,
+        plan,
         counted_from_the_end(plan),
         |t| {
             let k = t.ordinal.unsigned_abs();
@@ -3285,6 +3310,19 @@ pub(crate) mod tests {
             ),
             Some(2)
         );
+        // A finding about one pick is at its step, not at an earlier pick of its label:
+        // an unsaid colour on the second chair keeps the first chair and the sofa.
+        let chairs = "objects: [(chair, None, None), (sofa, None, red), (chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to_object(get_obj(\"chair\", #{colour: \"black\"}));";
+        assert_eq!(
+            first("the chair, then the red sofa, then another chair", chairs),
+            Some(2)
+        );
+        // The same note on two picks: the earlier stands for both.
+        let both = "objects: [(chair, None, None), (sofa, None, red), (chair, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2}));\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to_object(get_obj(\"chair\", #{ordinal: 2}));";
+        assert_eq!(
+            first("the chair, then the red sofa, then another chair", both),
+            Some(0)
+        );
         // A step past the plan's end is no place in it.
         let past = runtime_finding("x", None).at_step(5);
         assert_eq!(
@@ -3316,7 +3354,8 @@ pub(crate) mod tests {
                 label: "chair".into()
             })
         );
-        assert_eq!(f[0].about, Some(About::Label("chair".into())));
+        // At the chair's step (the pick that takes it).
+        assert_eq!(f[0].about, Some(About::Step(1)));
         // Excluding it is taking it too.
         let excluded = wrong.replace(
             "get_obj(\"chair\", #{colour:",
@@ -4120,7 +4159,7 @@ pub(crate) mod tests {
             .iter()
             .find(|x| x.to_model.contains("picks the sofa with ordinal -1, counted from the far end, but the person spoke of the far end only for the chair"))
             .unwrap_or_else(|| panic!("{f:?}"));
-        assert_eq!(sofa.about, Some(About::Label("sofa".into())));
+        assert_eq!(sofa.about, Some(About::Step(1)), "the sofa's step");
         assert!(
             f.iter().all(|x| !x.to_model.contains("picks the chair")),
             "{f:?}"
