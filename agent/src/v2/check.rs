@@ -2349,9 +2349,10 @@ pub(crate) fn far_end_said(instruction: &str) -> bool {
     starts_a_word(instruction, FAR_END_STEMS)
 }
 
-/// The starts of words that speak of the far end ([`far_end_said`]); "end" for "the
-/// third from the end", which counts from it.
-const FAR_END_STEMS: &[&str] = &["far", "furth", "distan", "last", "penult", "end"];
+/// The starts of words that speak of the far end ([`far_end_said`]). Not "end": held-out
+/// v10 (dev) kb02, "... and end on the platform", then offered the turnstile "furthest
+/// west" a count from the end, and the default model wrote it `ordinal: -1`.
+const FAR_END_STEMS: &[&str] = &["far", "furth", "distan", "last", "penult"];
 
 /// Whether `word` starts as a word that speaks of the far end does ("most distant",
 /// "far away", "lastly"): the one reading [`far_end_said`] and [`ends_said_of_sides`]

@@ -1225,7 +1225,7 @@ mod tests {
         let v = narrowed("go to the thrid red chair, then the black sofa", &[]);
         let ks = v.ordinals.clone().unwrap();
         assert_eq!(ks, vec![1, 3], "nothing said of an end: no count from one");
-        let ks = narrowed("go to the third chair from the end", &[])
+        let ks = narrowed("go to the third to last chair", &[])
             .ordinals
             .unwrap();
         for k in [1, -1, 3, -3] {
@@ -1257,7 +1257,7 @@ mod tests {
                 nint.is_empty() && pint.contains("\"3\"") && !pint.contains("\"2\""),
                 "{g}"
             );
-            let from_end = narrowed("go to the third red chair from the end", &[]);
+            let from_end = narrowed("go to the third to last red chair", &[]);
             let g = answer_lark(&from_end);
             assert!(g.contains("\"-3\""), "{g}");
             // Counted from the end: not in far_to_near.
@@ -1632,6 +1632,13 @@ mod tests {
         // and no far_to_near (the re-ask's bar, given before the first answer).
         let v = narrowed("go to the shelf furthest north, then the second chair", &[]);
         assert_eq!(v.ordinals, Some(vec![1, 2]));
+        assert!(v.no_far_end);
+        // "End" is no count from an end (held-out v10, dev, kb02).
+        let v = narrowed(
+            "the turnstile that's furthest west, and end on the platform",
+            &[],
+        );
+        assert_eq!(v.ordinals, Some(vec![1]));
         assert!(v.no_far_end);
         // Any other count from the end keeps -1 and far_to_near on offer.
         for instruction in [
