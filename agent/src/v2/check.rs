@@ -212,6 +212,25 @@ pub fn first_disputed_step(
         .into_iter()
         .map(|(_, l)| l)
         .collect();
+    // Where the plan lacks `l`: after the steps for what was named before it.
+    let missing = |l: &str| -> Option<usize> {
+        let named_at = mentions.iter().position(|m| m == l)?;
+        let mut m = 0;
+        let mut agreed: usize = 0;
+        for s in &plan.steps {
+            let ls = labels(s);
+            if ls.is_empty() || m + ls.len() > named_at || mentions[m..m + ls.len()] != ls[..] {
+                break;
+            }
+            m += ls.len();
+            agreed += 1;
+        }
+        Some(if m == named_at {
+            agreed.saturating_sub(1)
+        } else {
+            agreed
+        })
+    };
     let mut first: Option<usize> = None;
     for f in findings {
         let about = f.about.as_ref()?;
@@ -220,25 +239,6 @@ pub fn first_disputed_step(
             | (FindingKind::Parts, About::Missing(_)) => {}
             _ => return None,
         }
-        // Where the plan lacks `l`: after the steps for what was named before it.
-        let missing = |l: &str| -> Option<usize> {
-            let named_at = mentions.iter().position(|m| m == l)?;
-            let mut m = 0;
-            let mut agreed: usize = 0;
-            for s in &plan.steps {
-                let ls = labels(s);
-                if ls.is_empty() || m + ls.len() > named_at || mentions[m..m + ls.len()] != ls[..] {
-                    break;
-                }
-                m += ls.len();
-                agreed += 1;
-            }
-            Some(if m == named_at {
-                agreed.saturating_sub(1)
-            } else {
-                agreed
-            })
-        };
         let at = match about {
             About::Step(i) => (*i < plan.steps.len()).then_some(*i)?,
             About::Label(l) => match plan.steps.iter().position(|s| labels(s).contains(l)) {

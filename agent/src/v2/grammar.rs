@@ -496,19 +496,19 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
     // default order, the farthest) comes only with an order (`"last"` alone is left out
     // of its ordinal rule, suffix `p`), as in the plan's picks
     // ([`SelKeys::negative_needs_order`]).
-    let last = ordinal_signs(vocab).1;
+    let from_end = ordinal_signs(vocab).1;
     let mut tuple = |word: &str, c: (bool, bool, bool)| {
         let ordinal = format!(
             "{}{}",
             if c.1 { "tordinal" } else { "tordinal1" },
-            if c.2 || !last { "" } else { "p" }
+            if c.2 || !from_end { "" } else { "p" }
         );
         match order_rule(c) {
             None => format!("\"(\" {word} \", \" {ordinal} \", \" tcolour \")\""),
             Some((rule, orders)) => {
                 let mut out =
                     format!("\"(\" {word} \", \" {ordinal} \", \" tcolour (\", \" {rule})? \")\"");
-                if !c.2 && last {
+                if !c.2 && from_end {
                     out.push_str(&format!(
                         " | \"(\" {word} \", last, \" tcolour \", \" {rule} \")\""
                     ));

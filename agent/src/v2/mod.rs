@@ -336,15 +336,21 @@ fn narrow_colours_of_others(
     pose: Pose,
 ) {
     let only_of = check::colour_said_only_of(map, instruction, pose);
-    let before = v.clone();
-    v.colours_of = Some(name_groups(map, |label| {
-        let mut list = grammar::label_names(label.to_string())
-            .iter()
-            .find_map(|n| grammar::group_list(before.colours_of.as_deref(), n))
-            .unwrap_or_else(|| before.colours.clone());
+    let groups = name_groups(map, |label| {
+        let mut list = offered_colours(v, label);
         list.retain(|c| only_of(c).is_none_or(|of| of.iter().any(|l| l == label)));
         list
-    }));
+    });
+    v.colours_of = Some(groups);
+}
+
+/// The colours `v` offers a pick of map label `label`: its group's list in
+/// [`Vocabulary::colours_of`] under any of its names, else all of `v`'s colours.
+fn offered_colours(v: &Vocabulary, label: &str) -> Vec<String> {
+    grammar::label_names(label.to_string())
+        .iter()
+        .find_map(|n| grammar::group_list(v.colours_of.as_deref(), n))
+        .unwrap_or_else(|| v.colours.clone())
 }
 
 /// Offers what `what` selects with only to the names of the objects the person said it
@@ -585,10 +591,7 @@ fn barred_vocabulary(
         !of.is_empty() && of.iter().all(|l| l.as_str() != label)
     };
     v.colours_of = Some(name_groups(map, |label| {
-        let mut list = grammar::label_names(label.to_string())
-            .iter()
-            .find_map(|n| grammar::group_list(vocab.colours_of.as_deref(), n))
-            .unwrap_or_else(|| vocab.colours.clone());
+        let mut list = offered_colours(vocab, label);
         if required.contains(&label) {
             list.retain(|c| {
                 said_of
