@@ -139,6 +139,11 @@ pub struct PlanOptions {
     /// (`check::colour_said_only_of`: "the wheelchair closest to the blue hospital bed";
     /// default on; `--colours-of-others-allowed` turns it off).
     pub colours_of_others: bool,
+    /// The re-ask, and every draw after it, moves back to where the plan began where
+    /// the first answer did in a step no finding is about: no word check sees a
+    /// missing move back, so a re-ask that dropped it was accepted (default on;
+    /// `--reask-may-drop-return` turns it off).
+    pub reask_keeps_return: bool,
     /// The objects line's colours are the person's (default on; `--any-tuple-colours`
     /// turns it off).
     pub said_tuple_colours: bool,
@@ -207,6 +212,7 @@ impl Default for PlanOptions {
             orders_of_said: true,
             anchors_of_said: true,
             colours_of_others: true,
+            reask_keeps_return: true,
             said_tuple_colours: true,
             map_colours: true,
             redraws: 1,

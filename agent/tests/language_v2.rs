@@ -186,23 +186,37 @@ fn a_reask_keeps_the_steps_before_the_first_disputed_one() {
     assert_eq!(reqs[1].messages.len(), reqs[0].messages.len());
 }
 
-#[test]
-fn asked_to_come_back_the_grammar_requires_a_move_back_and_a_plan_without_one_is_reasked() {
-    let no_return = BLACK_SOFA_RIGHT;
-    let with_return = "objects: [(sofa, None, black)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_start();\n";
-    let (out, reqs) = plan_scripted(
-        &[no_return, with_return],
-        "go to the black sofa and then come back here",
-    );
+/// [`plan_scripted`] for a plan that must end moving back to the start after `repairs`
+/// re-asks or draws, the first re-ask noting `noted`; the requests made.
+fn returns_after_reask(
+    answers: &[&str],
+    instruction: &str,
+    repairs: u32,
+    noted: &str,
+) -> Vec<CompletionRequest> {
+    let (out, reqs) = plan_scripted(answers, instruction);
     let p = out.plan().expect("a plan after the re-ask");
-    assert_eq!(p.source, PlanSource::Llm { repairs: 1 });
+    assert_eq!(p.source, PlanSource::Llm { repairs });
     assert!(
         p.script.ends_with("agent.move_to_start();\n"),
         "{}",
         p.script
     );
     let reask = &reqs[1].messages.last().unwrap().content;
-    assert!(reask.contains("come back"), "{reask}");
+    assert!(reask.contains(noted), "{reask}");
+    reqs
+}
+
+#[test]
+fn asked_to_come_back_the_grammar_requires_a_move_back_and_a_plan_without_one_is_reasked() {
+    let no_return = BLACK_SOFA_RIGHT;
+    let with_return = "objects: [(sofa, None, black)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_start();\n";
+    let reqs = returns_after_reask(
+        &[no_return, with_return],
+        "go to the black sofa and then come back here",
+        1,
+        "come back",
+    );
     // The grammar (a backend that keeps it could not have written the first answer):
     // the first move back is its own rule.
     for r in &reqs {
@@ -212,6 +226,56 @@ fn asked_to_come_back_the_grammar_requires_a_move_back_and_a_plan_without_one_is
     // Not asked: no such rule.
     let (_, reqs) = plan_scripted(&[BLACK_SOFA_RIGHT], "go to the black sofa");
     assert!(!reqs[0].grammar.as_deref().unwrap().contains("ret ::="));
+}
+
+#[test]
+fn a_move_back_the_first_answer_made_is_kept_by_the_reask() {
+    // No word check reads this wording as a move back: only the first answer's own
+    // move back does.
+    let instruction = "take me to the sofa, the black one, then wind up at your original position";
+    let first = "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\nmove_to_start();\n";
+    let right = "objects: [(sofa, None, black)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_start();\n";
+    // The re-ask that dropped the move back is judged so, and the next draw keeps it.
+    let reqs = returns_after_reask(&[first, BLACK_SOFA_RIGHT, right], instruction, 2, "black");
+    assert!(!reqs[0].grammar.as_deref().unwrap().contains("ret ::="));
+    for r in &reqs[1..] {
+        assert!(r.grammar.as_deref().unwrap().contains("ret ::="));
+    }
+    // Off (`--reask-may-drop-return`), the re-ask may drop it.
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let b = Scripted::new(&[first, BLACK_SOFA_RIGHT]);
+    let mut ctx = v2(&map, &robot);
+    ctx.options.follow_objects = false;
+    ctx.options.reask_keeps_return = false;
+    let out = plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
+    let p = out.plan().expect("a plan after the re-ask");
+    assert!(!p.script.contains("move_to_start"), "{}", p.script);
+    assert!(!b.requests()[1]
+        .grammar
+        .as_deref()
+        .unwrap()
+        .contains("ret ::="));
+    // A first answer that made no move back asks for none.
+    let (out, reqs) = plan_scripted(&[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT], instruction);
+    assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 1 });
+    assert!(!reqs[1].grammar.as_deref().unwrap().contains("ret ::="));
+}
+
+#[test]
+fn a_position_nobody_said_is_not_offered_and_is_reasked() {
+    let instruction = "take me to the sofa, the black one, then return to this very spot";
+    let made_up = "objects: [(sofa, None, black)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to([1.0, 3.0]);\n";
+    let back = "objects: [(sofa, None, black)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_start();\n";
+    let reqs = returns_after_reask(&[made_up, back], instruction, 1, "position");
+    // The grammar (a backend that keeps it could not have written the first answer).
+    let g = reqs[0].grammar.as_deref().unwrap();
+    assert!(!g.contains("\"move_to(\""), "{g}");
+    assert!(g.contains("\"move_to_start(\""));
+    // A number said: a position may be one.
+    let (out, reqs) = plan_scripted(&[made_up], "take me to the black sofa, then go to 1, 3");
+    assert!(out.plan().is_some(), "{out:?}");
+    assert!(reqs[0].grammar.as_deref().unwrap().contains("\"move_to(\""));
 }
 
 #[test]

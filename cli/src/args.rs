@@ -315,6 +315,10 @@ pub(crate) struct ModelArgs {
     /// before stop 70; for comparison).
     #[arg(long)]
     pub(crate) colours_of_others_allowed: bool,
+    /// Let the re-ask drop the move back to the start that the first answer made (the
+    /// default before stop 71; for comparison).
+    #[arg(long)]
+    pub(crate) reask_may_drop_return: bool,
     /// Let a tuple on the objects line carry any colour word, not only a colour the
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
@@ -395,6 +399,7 @@ impl ModelArgs {
             orders_of_said: !self.any_direction,
             anchors_of_said: !self.anchors_anywhere,
             colours_of_others: !self.colours_of_others_allowed,
+            reask_keeps_return: !self.reask_may_drop_return,
             said_tuple_colours: !self.any_tuple_colours,
             map_colours: !self.any_pick_colours,
             redraws: self.redraws,

@@ -1162,7 +1162,21 @@ fn side_count(w: &[String], at: usize) -> Option<SideCount> {
     let before = at.saturating_sub(FROM_WORDS)..at;
     let counting = at > 0 && w[at - 1].starts_with("count");
     let span = match w[before.clone()].iter().position(is_count) {
-        Some(p) => before.start + p..at + 3,
+        // A count from the end may begin two words earlier, outside the window: "the
+        // second from last dog kennel counting from the west" (held-out v11, dev, lc09:
+        // read as "last ... from the west", ordinal 1, a right plan was re-asked).
+        Some(p) => {
+            let p = before.start + p;
+            let joined = p >= 2
+                && counts_from_the_end(&w[p])
+                && matches!(w[p - 1].as_str(), "to" | "from")
+                && said_count(&w[p - 2]).is_some_and(|k| k > 1);
+            if joined {
+                p - 2..at + 3
+            } else {
+                p..at + 3
+            }
+        }
         None if counting => {
             let p = w
                 .iter()
@@ -4497,6 +4511,13 @@ pub(crate) mod tests {
                 "#{ordinal: 2}",
                 "that is ordinal: 2 with order \"south_to_north\"",
             ),
+            // A count from the end begun six words before "from" (held-out v11, dev,
+            // lc09).
+            (
+                "the second from last red chair counting from the west",
+                "#{ordinal: 2, colour: \"red\", order: \"west_to_east\"}",
+                "said \"second from last red chair counting from the west\": that is ordinal: 2 with order \"east_to_west\"",
+            ),
         ] {
             assert_word_finding(instruction, "chair", select, says);
         }
@@ -4517,6 +4538,14 @@ pub(crate) mod tests {
             (
                 "1) first chair from the east 2) the sofa",
                 "#{order: \"east_to_west\"}",
+            ),
+            (
+                "the second from last red chair counting from the west",
+                "#{ordinal: 2, colour: \"red\", order: \"east_to_west\"}",
+            ),
+            (
+                "the second to last red chair counting from the west",
+                "#{ordinal: -2, colour: \"red\", order: \"west_to_east\"}",
             ),
             // No count near: "from the west" says nothing to count.
             ("go to the chair, coming from the west", "#{ordinal: 1}"),

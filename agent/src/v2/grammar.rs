@@ -128,6 +128,19 @@ pub struct Vocabulary {
     /// made a plain stop ([`check::Bar::SideStop`](super::check::Bar::SideStop)).
     /// Empty: no such bar, and the grammar is the same as without the field.
     pub no_goto: Vec<String>,
+    /// Offer no step that moves to a position (`move_to([x, y])`, a registered function
+    /// with a [`ParamType::Position`] parameter): outside a conversation the person said
+    /// no number, so any position would be one the model made up (held-out v11, dev,
+    /// la07: "then return to this very spot" was `move_to([1.0, 3.0])` in all three
+    /// runs). Off: such steps are offered, and the grammar is the same as without the
+    /// field.
+    pub no_positions: bool,
+    /// Names whose picks count only from the start (no negative ordinal): the answer's
+    /// objects line counted every object of their label from the start in a direction
+    /// (`(hose reel, 2, None, east_to_west)`), and the plan follows it
+    /// (`v2::follow_objects`). Empty: no such hold, and the grammar is the same as
+    /// without the field.
+    pub from_start_of: Vec<String>,
 }
 
 /// The step function of a plain stop at an object ([`Step::GoTo`](planner_dsl::typed::Step::GoTo)),
@@ -248,6 +261,8 @@ impl Vocabulary {
             tuple_colours: None,
             no_stops: Vec::new(),
             no_goto: Vec::new(),
+            no_positions: false,
+            from_start_of: Vec::new(),
         }
     }
 
@@ -671,6 +686,11 @@ fn arg_rule(ty: ParamType, obj: &str) -> &str {
     }
 }
 
+/// Whether the registered function `name` takes a position (`[x, y]`).
+fn takes_position(name: &str) -> bool {
+    planner_dsl::lookup(name).is_some_and(|f| f.params.iter().any(|p| p.ty == ParamType::Position))
+}
+
 /// The call rule of a registered function: `"name(" args ")"`, optional parameters
 /// optional. A name followed by a selection ("between the two yellow tables") is written
 /// by `namesel`, which holds the selection to what the name's objects offer a pair
@@ -1014,6 +1034,8 @@ struct PickGroup {
     /// The names its picks may be picked near (`None`: any; empty: no `near:`;
     /// [`Vocabulary::anchors_of`]). Pair groups take any.
     anchors: Option<Vec<String>>,
+    /// Its picks count only from the start ([`Vocabulary::from_start_of`]).
+    no_negative: bool,
 }
 
 impl PickGroup {
@@ -1052,7 +1074,7 @@ impl PickGroup {
         }
         let flags = OrderEnds {
             not_from_end: !rest.is_empty(),
-            negative: !self.no_far_end || !ends.is_empty(),
+            negative: (!self.no_far_end || !ends.is_empty()) && !self.no_negative,
             negative_needs_order: self.no_far_end,
         };
         (ends, rest, flags)
@@ -1104,6 +1126,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
         && vocab.counts_of.is_none()
         && vocab.far_ends_of.is_none()
         && vocab.anchors_of.is_none()
+        && vocab.from_start_of.is_empty()
     {
         return None;
     }
@@ -1153,6 +1176,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
             Some(a) if !pairs => Some(group_list(Some(a), name).unwrap_or_default()),
             _ => None,
         };
+        let no_negative = !pairs && vocab.from_start_of.contains(name);
         match groups.iter_mut().find(|g| {
             g.colours == colours
                 && g.not_colours == not_colours
@@ -1163,6 +1187,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
                 && g.no_counts == no_counts
                 && g.no_far_end == no_far_end
                 && g.anchors == anchors
+                && g.no_negative == no_negative
         }) {
             Some(g) => g.names.push(name.clone()),
             None => groups.push(PickGroup {
@@ -1176,6 +1201,7 @@ fn pick_groups(vocab: &Vocabulary, pairs: bool) -> Option<Vec<PickGroup>> {
                 no_counts,
                 no_far_end,
                 anchors,
+                no_negative,
             }),
         }
     }
@@ -1448,7 +1474,12 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         .partition(|n| RETURN_FUNCTIONS.contains(n));
     // Each statement rule twice: with a variable on offer (`obj`) and without (`objn`).
     for (sfx, obj, goto) in [("", &sobj, &gobj), ("n", &sobjn, &gobjn)] {
-        let call = |n: &&str| call_rule(n, if *n == GOTO_FUNCTION { goto } else { obj }, pairs);
+        let call = |n: &&str| {
+            if vocab.no_positions && takes_position(n) {
+                return None;
+            }
+            call_rule(n, if *n == GOTO_FUNCTION { goto } else { obj }, pairs)
+        };
         let steps: Vec<String> = STEP_FUNCTIONS.iter().filter_map(call).collect();
         w.rule(
             &format!("step{sfx}"),
@@ -2001,6 +2032,28 @@ pub(crate) mod tests {
         // Not asked: a plan may end anywhere.
         v.return_required = false;
         lark_accepts(&answer_lark(&v), &format!("{objects}{sofa}")).unwrap();
+    }
+
+    #[test]
+    fn no_position_is_offered_where_none_was_said() {
+        let mut v = vocab();
+        let objects = "objects: [(sofa, None, None)]\nplan:\n";
+        let sofa = "move_to_object(get_obj(\"sofa\"));";
+        let to_position = format!("{sofa}\nmove_to([1.0, 3.0]);");
+        let to_start = format!("{sofa}\nmove_to_start();");
+        for ret in [false, true] {
+            v.return_required = ret;
+            v.no_positions = false;
+            lark_accepts(&answer_lark(&v), &format!("{objects}{to_position}")).unwrap();
+            v.no_positions = true;
+            assert!(lark_accepts(&answer_lark(&v), &format!("{objects}{to_position}")).is_err());
+            assert!(lark_accepts(&plan_lark(&v), &to_position).is_err());
+            // The move back to the start, and turns by a number, stay.
+            lark_accepts(&answer_lark(&v), &format!("{objects}{to_start}")).unwrap();
+            lark_accepts(&plan_lark(&v), &format!("{to_start}\nturn(180);")).unwrap();
+            assert_eq!(undefined_rules(&answer_grammar(&v)), Vec::<String>::new());
+            assert!(!answer_grammar(&v).contains("\"move_to(\""));
+        }
     }
 
     #[test]

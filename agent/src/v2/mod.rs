@@ -144,8 +144,42 @@ struct Accepted {
     plan: Plan,
 }
 
-/// Reads, checks and dry-runs one answer.
-fn assess(text: &str, instruction: &str, ctx: &PlanContext<'_>) -> Result<Accepted, Vec<Finding>> {
+/// Whether no position is said: outside a conversation (no history, no references, no
+/// earlier instruction), an instruction with no digit. A position (`move_to([x, y])`)
+/// comes from a number the person said or from the conversation's "we started at";
+/// else the grammar offers none ([`Vocabulary::no_positions`]) and [`assess`] finds it.
+fn no_position_said(instruction: &str, ctx: &PlanContext<'_>) -> bool {
+    ctx.references.is_empty()
+        && ctx.earlier.is_none()
+        && ctx.history.is_none()
+        && !instruction.chars().any(|c| c.is_ascii_digit())
+}
+
+/// Whether the answer `text` moves back to where it began in a step that no finding of
+/// `findings` is about ([`check::About::Step`]). No word check sees a move back that a
+/// later answer drops: held-out v11 (dev) lb01 and lb03, and v10 (dev) ka14 and kc10,
+/// lost the return their first answers made ("then get yourself home to this spot",
+/// "then back to where you started") in the re-ask about another step, in every run.
+fn undisputed_return(text: &str, findings: &[Finding]) -> bool {
+    let Ok(answer) = parse_answer(text) else {
+        return false;
+    };
+    answer.plan.steps.iter().enumerate().any(|(i, s)| {
+        check::steps_return(std::slice::from_ref(s))
+            && !findings
+                .iter()
+                .any(|f| f.about == Some(check::About::Step(i)))
+    })
+}
+
+/// Reads, checks and dry-runs one answer; with `must_return`, an answer that never moves
+/// back to the start is a finding ([`undisputed_return`] of an earlier answer).
+fn assess(
+    text: &str,
+    instruction: &str,
+    ctx: &PlanContext<'_>,
+    must_return: bool,
+) -> Result<Accepted, Vec<Finding>> {
     let unreadable = |to_model: String| {
         vec![Finding::new(
             FindingKind::Unreadable,
@@ -195,6 +229,28 @@ fn assess(text: &str, instruction: &str, ctx: &PlanContext<'_>) -> Result<Accept
         &visited,
         &ctx.references,
     );
+    if ctx.options.said_only
+        && no_position_said(instruction, ctx)
+        && answer
+            .plan
+            .steps
+            .iter()
+            .any(|s| matches!(s, planner_dsl::typed::Step::MoveTo(_)))
+    {
+        found.push(Finding::new(
+            FindingKind::Word,
+            "the plan moves to a position ([x, y]) the person never said: to come back to where you began write move_to_start(); to go to a thing or a room, pick it",
+            "where exactly should I go?",
+        ));
+    }
+    // Where the person's words already ask for a move back, that check has said so.
+    if must_return && !check::plan_returns(&answer.plan) && !check::return_said(instruction) {
+        found.push(Finding::new(
+            FindingKind::Word,
+            "a first answer moved back to where you began, and nothing disputed that, but this plan never moves back: write move_to_start(); where the person's words say to come back",
+            "should I come back to where I started, and when?",
+        ));
+    }
     // The map's own answer first: it says what the map holds.
     if let Some(e) = run_error {
         found.insert(0, e);
@@ -711,6 +767,7 @@ pub fn plan_instruction(
             );
             // Asked for by this instruction's words alone, as the checks read them.
             v.return_required = check::return_said(instruction);
+            v.no_positions = no_position_said(instruction, ctx);
         }
         if ctx.options.said_colours_required && ctx.references.is_empty() {
             if let Some(r) = said_colours_required(&v, ctx.map, instruction, ctx.pose()) {
@@ -737,6 +794,9 @@ pub fn plan_instruction(
     let draws = draws(&ctx.options);
     // What the re-ask keeps of the first answer (`PlanOptions::reask_holds_agreed`).
     let mut held: Option<Held> = None;
+    // The first answer moved back to the start, and no finding was about that
+    // (`PlanOptions::reask_keeps_return`): every later answer must too.
+    let mut must_return = false;
     for (round, draw) in draws.iter().enumerate() {
         let round = u32::try_from(round).unwrap_or(u32::MAX);
         let mut req = CompletionRequest::new(
@@ -765,7 +825,7 @@ pub fn plan_instruction(
             c
         };
         attempts.push(c.text.clone());
-        let f = match assess(&c.text, instruction, ctx) {
+        let f = match assess(&c.text, instruction, ctx, must_return) {
             Ok(a) => {
                 timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
                 return Ok(Outcome::Plan(Box::new(PlannedInstruction {
@@ -794,9 +854,17 @@ pub fn plan_instruction(
                 if let Some(last) = msgs.last_mut() {
                     last.content = format!("{}\n{}", last.content, reask.content);
                 }
-                if let Some(v) =
-                    reask_vocabulary(&vocab, ctx.map, instruction, &known, &f, ctx.pose())
-                {
+                let mut reasked =
+                    reask_vocabulary(&vocab, ctx.map, instruction, &known, &f, ctx.pose());
+                if ctx.options.reask_keeps_return && undisputed_return(&c.text, &f) {
+                    must_return = true;
+                    if !vocab.return_required {
+                        let mut v = reasked.take().unwrap_or_else(|| vocab.clone());
+                        v.return_required = true;
+                        reasked = Some(v);
+                    }
+                }
+                if let Some(v) = reasked {
                     (grammar, lark) = grammar_of(&v);
                     current = v;
                 }
@@ -1002,6 +1070,48 @@ fn answer_following_objects(
     })
 }
 
+/// The names of `v` whose label the objects line `tuples` counts from the start in a
+/// direction in every tuple of it (`(hose reel, 2, None, east_to_west)`, an order `v`
+/// offers: one the person said): the plan's picks of them take no negative ordinal
+/// ([`Vocabulary::from_start_of`]). Measured on held-out v11 (dev): "the second-to-last
+/// hose reel from the west" and "the second to last recliner from the west" were listed
+/// so and planned `#{ordinal: -2, order: "east_to_west"}` (the second from the west) in
+/// all three runs, re-asked, and lost (la09, lb09).
+fn counted_from_start(
+    v: &Vocabulary,
+    map: &map_core::IvlMap,
+    tuples: &[Tuple],
+    pose: Pose,
+) -> Vec<String> {
+    let from_start = |t: &Tuple| {
+        t.ordinal.is_some_and(|k| k > 0)
+            && t.order
+                .as_deref()
+                .and_then(|o| map_core::ObjectOrder::parse(o).ok())
+                .is_some_and(|o| {
+                    o.is_directional()
+                        && !v.no_directions
+                        && v.directions.as_ref().is_none_or(|d| d.contains(&o))
+                })
+    };
+    let mut labels: Vec<(String, bool)> = Vec::new();
+    for t in tuples {
+        let Some(label) = check::object_label(map, &t.object, pose) else {
+            continue;
+        };
+        match labels.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, all)) => *all &= from_start(t),
+            None => labels.push((label, from_start(t))),
+        }
+    }
+    labels
+        .into_iter()
+        .filter(|(_, all)| *all)
+        .flat_map(|(label, _)| label_names(label))
+        .filter(|n| v.names.contains(n))
+        .collect()
+}
+
 /// `v` with its picks held to the answer's objects line `tuples` where the person's
 /// words agree with it (design.md, "How the language layer should work"): a map label
 /// whose every tuple gives a colour, one that the person said right before that label's
@@ -1031,6 +1141,7 @@ pub(crate) fn follow_objects(
         }
     }
     let mut out = v.clone();
+    out.from_start_of = counted_from_start(v, map, tuples, pose);
     let mut narrowed: Vec<(Vec<String>, Vec<String>)> = Vec::new();
     for (label, cs) in listed {
         let Some(cs) = cs.into_iter().collect::<Option<Vec<String>>>() else {
@@ -1088,6 +1199,26 @@ pub(crate) fn follow_objects(
 mod tests {
     use super::check::tests::map;
     use super::*;
+
+    #[test]
+    fn a_move_back_no_finding_is_about_is_undisputed() {
+        let answer = "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\nmove_to_start();";
+        let about = |a: check::About| {
+            let mut f = Finding::new(FindingKind::Word, "x", "y");
+            f.about = Some(a);
+            f
+        };
+        assert!(undisputed_return(answer, &[]));
+        assert!(undisputed_return(answer, &[about(check::About::Step(0))]));
+        assert!(undisputed_return(
+            answer,
+            &[about(check::About::Label("sofa".into()))]
+        ));
+        assert!(!undisputed_return(answer, &[about(check::About::Step(1))]));
+        let no_return = "objects: [(sofa, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));";
+        assert!(!undisputed_return(no_return, &[]));
+        assert!(!undisputed_return("not an answer", &[]));
+    }
 
     fn narrowed(instruction: &str, references: &[u32]) -> Vocabulary {
         let m = map();
@@ -1147,6 +1278,52 @@ mod tests {
         let lark = objects_lark(&extract_vocabulary(south, &open));
         let line = "objects: [(cabinet, last, None, south_to_north)]\n";
         assert!(grammar::tests::lark_accepts(&lark, line).is_ok());
+    }
+
+    #[test]
+    fn the_plan_counts_from_the_start_where_its_objects_line_does_in_a_direction() {
+        let m = map();
+        let v = Vocabulary::for_map(&m);
+        let pose = PlanContext::new(&m).pose();
+        let follow = |v: &Vocabulary, line: &str| follow_objects(v, &m, &tuples(line), &[], pose);
+        let f = follow(&v, "[(couch, 2, None, east_to_west), (table, None, None)]");
+        let mut names = f.from_start_of.clone();
+        names.sort();
+        assert_eq!(names, ["couch", "settee", "sofa"]);
+        // Under those names, a pick counts from the start only; other names as before.
+        let lark = plan_lark(&f);
+        let pick = |sel: &str| format!("move_to_object(get_obj(\"sofa\", #{{{sel}}}));");
+        grammar::tests::lark_accepts(&lark, &pick("ordinal: 2, order: \"east_to_west\"")).unwrap();
+        assert!(
+            grammar::tests::lark_accepts(&lark, &pick("ordinal: -2, order: \"east_to_west\""))
+                .is_err()
+        );
+        grammar::tests::lark_accepts(
+            &lark,
+            "move_to_object(get_obj(\"table\", #{ordinal: -2, order: \"east_to_west\"}));",
+        )
+        .unwrap();
+        // Not every tuple of the label counted so, no order, an order by distance, or a
+        // direction the vocabulary does not offer: no hold.
+        for line in [
+            "[(sofa, 2, None, east_to_west), (sofa, last, None)]",
+            "[(sofa, 2, None)]",
+            "[(sofa, 2, None, far_to_near)]",
+            "[(sofa, last, None, east_to_west)]",
+        ] {
+            assert!(follow(&v, line).from_start_of.is_empty(), "{line}");
+        }
+        let mut west = v.clone();
+        west.directions = Some(vec![map_core::ObjectOrder::WestToEast]);
+        assert!(follow(&west, "[(sofa, 2, None, east_to_west)]")
+            .from_start_of
+            .is_empty());
+        assert_eq!(
+            follow(&west, "[(sofa, 2, None, west_to_east)]")
+                .from_start_of
+                .len(),
+            3
+        );
     }
 
     #[test]
