@@ -1076,7 +1076,9 @@ fn answer_following_objects(
 /// ([`Vocabulary::from_start_of`]). Measured on held-out v11 (dev): "the second-to-last
 /// hose reel from the west" and "the second to last recliner from the west" were listed
 /// so and planned `#{ordinal: -2, order: "east_to_west"}` (the second from the west) in
-/// all three runs, re-asked, and lost (la09, lb09).
+/// all three runs, re-asked, and lost (la09, lb09). It holds only where the plan is a
+/// request of its own ([`crate::PlanOptions::follow_objects`], off by default), so those
+/// runs, with one grammar for the whole answer, did not have it.
 fn counted_from_start(
     v: &Vocabulary,
     map: &map_core::IvlMap,
