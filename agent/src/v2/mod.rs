@@ -1106,12 +1106,11 @@ fn counted_from_start(
             None => labels.push((label, from_start(t))),
         }
     }
-    labels
+    let counted: Vec<String> = labels
         .into_iter()
-        .filter(|(_, all)| *all)
-        .flat_map(|(label, _)| label_names(label))
-        .filter(|n| v.names.contains(n))
-        .collect()
+        .filter_map(|(label, all)| all.then_some(label))
+        .collect();
+    names_of_labels(v, map, &counted, pose)
 }
 
 /// `v` with its picks held to the answer's objects line `tuples` where the person's
