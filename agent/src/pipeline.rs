@@ -95,7 +95,8 @@ pub struct PlanOptions {
     /// Colours are narrowed only with `said_colours`.
     pub said_only: bool,
     /// With `said_only`, outside a conversation: a pick of each object may select only
-    /// on the colours the person said that some object of that name has on this map.
+    /// on the colours the person said that some object of that name has on this map
+    /// (default on since stop 72; `--unsaid-colours-allowed` turns it off).
     pub said_colours: bool,
     /// With `said_only`, outside a conversation: a pick (and a pair of
     /// `move_between_the_two`) may exclude a colour (`not_colour`) only where the person
@@ -202,7 +203,7 @@ impl Default for PlanOptions {
             answer_grammar: true,
             llguidance: true,
             said_only: true,
-            said_colours: false,
+            said_colours: true,
             said_exclusions: true,
             directions_of_said: true,
             counts_of_said: true,

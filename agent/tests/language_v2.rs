@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 
 use agent::v2::answer::{parse_answer, AnswerError};
 use agent::v2::grammar::Vocabulary;
-use agent::{plan_instruction, Outcome, PlanContext, PlanSource, Prompts, Session};
+use agent::{plan_instruction, Outcome, PlanContext, PlanOptions, PlanSource, Prompts, Session};
 use llm::{
     Completion, CompletionRequest, FinishReason, LlamaCppBackend, LlamaCppConfig, LlmBackend,
     LlmError, Role,
@@ -94,11 +94,20 @@ fn plan_scripted_with(
     instruction: &str,
     follow_objects: bool,
 ) -> (Outcome, Vec<CompletionRequest>) {
+    plan_scripted_opts(answers, instruction, |o| o.follow_objects = follow_objects)
+}
+
+/// [`plan_scripted`] with the default options as `set` leaves them.
+fn plan_scripted_opts(
+    answers: &[&str],
+    instruction: &str,
+    set: impl FnOnce(&mut PlanOptions),
+) -> (Outcome, Vec<CompletionRequest>) {
     let map = flat_a();
     let robot = SimRobot::new(map.clone());
     let b = Scripted::new(answers);
     let mut ctx = v2(&map, &robot);
-    ctx.options.follow_objects = follow_objects;
+    set(&mut ctx.options);
     let out = plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
     (out, b.requests())
 }
@@ -302,11 +311,10 @@ fn between_the_two_of_three_picked_by_their_counts_is_a_question_not_a_guess() {
 fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
     let red_sofa =
         "objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));\n";
-    let (out, reqs) = plan_scripted_with(
-        &[red_sofa, BLACK_SOFA_RIGHT],
-        "take me to the sofa, the black one",
-        false,
-    );
+    // With every colour of the map on offer in the first grammar (`said_colours` off):
+    let all_colours = |o: &mut PlanOptions| o.said_colours = false;
+    let said = "take me to the sofa, the black one";
+    let (out, reqs) = plan_scripted_opts(&[red_sofa, BLACK_SOFA_RIGHT], said, all_colours);
     assert!(out.plan().is_some(), "{out:?}");
     assert_eq!(reqs.len(), 2);
     // The re-ask's grammars are the first request's less what the finding bars (which
@@ -314,13 +322,15 @@ fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
     assert_ne!(reqs[1].lark, reqs[0].lark);
     assert_ne!(reqs[1].grammar, reqs[0].grammar);
     // A finding that bars nothing (a said colour left out) keeps the first grammar.
-    let (_, reqs) = plan_scripted_with(
-        &[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT],
-        "take me to the sofa, the black one",
-        false,
-    );
+    let (_, reqs) = plan_scripted_opts(&[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT], said, all_colours);
     assert_eq!(reqs[1].lark, reqs[0].lark);
     assert_eq!(reqs[1].grammar, reqs[0].grammar);
+    // By default the first grammar offers the sofa only the said colour, so a backend
+    // that keeps to grammars cannot give red; one that does not is re-asked all the same.
+    let (out, default_reqs) = plan_scripted(&[red_sofa, BLACK_SOFA_RIGHT], said);
+    assert!(out.plan().is_some(), "{out:?}");
+    assert_eq!(default_reqs.len(), 2);
+    assert_ne!(default_reqs[0].lark, reqs[0].lark);
 }
 
 #[test]

@@ -266,9 +266,14 @@ pub(crate) struct ModelArgs {
     #[arg(long)]
     pub(crate) open_selections: bool,
     /// Narrow each pick's colours to those the person said that an object of that name
-    /// has on the map (outside a conversation; for comparison).
-    #[arg(long, conflicts_with = "open_selections")]
+    /// has on the map, outside a conversation. The default since stop 72; the flag is
+    /// kept so that earlier commands still run.
+    #[arg(long, conflicts_with_all = ["open_selections", "unsaid_colours_allowed"])]
     pub(crate) said_colours: bool,
+    /// Let a pick select on any colour its objects have on the map, said or not (the
+    /// default before stop 72; for comparison; the checks then re-ask an unsaid one).
+    #[arg(long)]
+    pub(crate) unsaid_colours_allowed: bool,
     /// Let a pick exclude any colour its objects tell apart by (`not_colour`), not only
     /// a colour the person said where a word excludes something (the default before
     /// stop 63; for comparison).
@@ -388,7 +393,7 @@ impl ModelArgs {
             llguidance: !self.gbnf,
             answer_grammar: !self.no_grammar,
             said_only: !self.open_selections,
-            said_colours: self.said_colours,
+            said_colours: self.said_colours || !self.unsaid_colours_allowed,
             said_exclusions: !self.any_not_colours,
             directions_of_said: !self.directions_anywhere,
             counts_of_said: !self.counts_anywhere,
