@@ -107,6 +107,12 @@ pub struct PlanOptions {
     /// only where the person said a direction of its object, in the clause naming it
     /// (default on; `--directions-anywhere` turns it off).
     pub directions_of_said: bool,
+    /// With `said_only`, outside a conversation: a pick may select in a region
+    /// (`region:`) only where the person said that region of its object, in the clause
+    /// naming it or a clause next to it that names no object, and `assess` finds such a
+    /// pick from a backend without grammars (off by default until judged on the dev
+    /// sets; `--regions-of-said` turns it on).
+    pub regions_of_said: bool,
     /// With `said_only`, outside a conversation: a pick may count two or more (either
     /// end) only where the person said a count of its object, in the clause naming it
     /// (default on; `--counts-anywhere` turns it off).
@@ -206,6 +212,7 @@ impl Default for PlanOptions {
             said_colours: true,
             said_exclusions: true,
             directions_of_said: true,
+            regions_of_said: false,
             counts_of_said: true,
             far_ends_of_said: true,
             side_stops_of_said: false,

@@ -815,3 +815,32 @@ fn chat_references_count_the_visits_and_a_revisit_for_the_other_one_is_reasked()
         "the black sofa, visited first"
     );
 }
+
+#[test]
+fn with_regions_of_said_a_room_said_of_another_object_is_reasked() {
+    let said =
+        "the table closest to the red sofa. Then the third chair, and then into the dining room";
+    let answer = |table_region: &str| {
+        format!(
+            "objects: [(table, None, None), (sofa, None, red), (chair, 3, None), (dining room, None, None)]\nplan:\nmove_to_object(get_obj(\"table\", #{{{table_region}near: get_obj(\"sofa\", #{{colour: \"red\"}})}}));\nmove_to_object(get_obj(\"chair\", #{{ordinal: 3}}));\nmove_to_object(\"dining room\");\n"
+        )
+    };
+    let (wrong, right) = (answer("region: \"dining room\", "), answer(""));
+    let on = |o: &mut PlanOptions| o.regions_of_said = true;
+    let (out, reqs) = plan_scripted_opts(&[&wrong, &right], said, on);
+    assert!(out.plan().is_some(), "{out:?}");
+    assert_eq!(reqs.len(), 2, "one re-ask");
+    let last = &reqs[1].messages.last().unwrap().content;
+    assert!(
+        last.contains("did not put the table in the dining room"),
+        "{last}"
+    );
+    // The right answer stands at once.
+    let (out, reqs) = plan_scripted_opts(&[&right], said, on);
+    assert!(out.plan().is_some(), "{out:?}");
+    assert_eq!(reqs.len(), 1);
+    // Off (the default): the answer is not judged on it.
+    let (out, reqs) = plan_scripted(&[&wrong], said);
+    assert!(out.plan().is_some(), "{out:?}");
+    assert_eq!(reqs.len(), 1);
+}

@@ -284,6 +284,11 @@ pub(crate) struct ModelArgs {
     /// 64; for comparison).
     #[arg(long)]
     pub(crate) directions_anywhere: bool,
+    /// Let a pick select in a room (`region:`) only where the instruction says that room
+    /// of its object, in the clause naming it or one next to it naming no object (off
+    /// by default until judged).
+    #[arg(long)]
+    pub(crate) regions_of_said: bool,
     /// Let a pick of any object count two or more wherever the instruction says such a
     /// count, not only one whose clause says it (the default before stop 64; for
     /// comparison).
@@ -396,6 +401,7 @@ impl ModelArgs {
             said_colours: self.said_colours || !self.unsaid_colours_allowed,
             said_exclusions: !self.any_not_colours,
             directions_of_said: !self.directions_anywhere,
+            regions_of_said: self.regions_of_said,
             counts_of_said: !self.counts_anywhere,
             far_ends_of_said: !self.far_end_anywhere,
             side_stops_of_said: self.side_stops_barred,

@@ -243,6 +243,18 @@ fn assess(
             "where exactly should I go?",
         ));
     }
+    if ctx.options.said_only
+        && ctx.options.regions_of_said
+        && ctx.references.is_empty()
+        && ctx.earlier.is_none()
+    {
+        found.extend(check::check_regions_of_others(
+            ctx.map,
+            instruction,
+            &answer.plan,
+            pose,
+        ));
+    }
     // Where the person's words already ask for a move back, that check has said so.
     if must_return && !check::plan_returns(&answer.plan) && !check::return_said(instruction) {
         found.push(Finding::new(
@@ -323,6 +335,9 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
             if on && ctx.earlier.is_none() {
                 narrow_said_of(v, ctx.map, instruction, ctx.pose(), what);
             }
+        }
+        if ctx.options.regions_of_said && ctx.earlier.is_none() {
+            narrow_regions_of_said(v, ctx.map, instruction, ctx.pose());
         }
         if ctx.options.side_stops_of_said && ctx.earlier.is_none() {
             narrow_side_stops(v, ctx.map, instruction, ctx.pose());
@@ -446,6 +461,36 @@ fn narrow_said_of(
         check::SaidOf::Count => v.counts_of = names,
         check::SaidOf::FarEnd => v.far_ends_of = names,
     }
+}
+
+/// Offers a pick of each name only the regions said of its object
+/// ([`check::regions_said_of`]: in the clause naming it, or in a clause naming no object
+/// next to it), within those [`Vocabulary::regions_of`] already gives it; a name said of
+/// no region takes no `region` key (`PlanOptions::regions_of_said`, off by default until
+/// judged). Its check is [`check::check_regions_of_others`], in [`assess`]. Held-out
+/// v10 (dev) ka05: "the wheelchair closest to the blue hospital bed. Then the
+/// westernmost stretcher, and then into triage" picked the wheelchair in triage.
+fn narrow_regions_of_said(
+    v: &mut Vocabulary,
+    map: &map_core::IvlMap,
+    instruction: &str,
+    pose: Pose,
+) {
+    let said = check::regions_said_of(map, instruction, pose);
+    let current = v.regions_of.take();
+    let all = v.regions.clone();
+    v.regions_of = Some(grammar::name_groups(map, |label| {
+        let mut list = grammar::label_names(label.to_string())
+            .iter()
+            .find_map(|n| grammar::group_list(current.as_deref(), n))
+            .unwrap_or_else(|| all.clone());
+        let of: &[String] = said
+            .iter()
+            .find(|(l, _)| l == label)
+            .map_or(&[], |(_, r)| r.as_slice());
+        list.retain(|r| of.contains(r));
+        list
+    }));
 }
 
 /// Bars `move_to_object` (and a `let`) from the objects the person named once, as a stop
@@ -2213,6 +2258,47 @@ mod tests {
         );
         // By default (`PlanOptions::side_stops_of_said` off) a plain stop is offered.
         assert!(narrowed(said, &[]).no_goto.is_empty());
+    }
+
+    #[test]
+    fn a_pick_is_offered_only_the_rooms_said_of_its_object() {
+        // Held-out v10 (dev) ka05's form on flat-a, whose dining room holds tables and
+        // chairs: the room said after the chair is not the table's.
+        let said = "the table closest to the red sofa. Then the third chair, and then into the dining room";
+        let on = {
+            let m = map();
+            let mut ctx = PlanContext::new(&m);
+            ctx.options.regions_of_said = true;
+            let mut v = Vocabulary::for_map(&m);
+            v.map_colours(&m);
+            narrow_to_words(&mut v, said, &ctx);
+            answer_lark(&v)
+        };
+        grammar::tests::assert_offers(
+            &on,
+            one_pick,
+            &[
+                r#""chair", #{ordinal: 3, region: "dining room"}"#,
+                r#""table", #{near: get_obj("sofa", #{colour: "red"})}"#,
+            ],
+            &[
+                r#""table", #{region: "dining room"}"#,
+                r#""sofa", #{region: "dining room"}"#,
+            ],
+        );
+        // Off (the default until judged): any pick may take the room said.
+        let m = map();
+        let mut ctx = PlanContext::new(&m);
+        ctx.options.regions_of_said = false;
+        let mut v = Vocabulary::for_map(&m);
+        v.map_colours(&m);
+        narrow_to_words(&mut v, said, &ctx);
+        grammar::tests::assert_offers(
+            &answer_lark(&v),
+            one_pick,
+            &[r#""table", #{region: "dining room"}"#],
+            &[],
+        );
     }
 
     #[test]
