@@ -1280,10 +1280,20 @@ mod tests {
     /// The Lark grammar of flat-a's vocabulary (its colours per object) narrowed to the
     /// words of `instruction` outside a conversation.
     fn narrowed_grammar(instruction: &str) -> String {
+        narrowed_grammar_with(instruction, |_| {})
+    }
+
+    /// [`narrowed_grammar`] with the default options as `set` leaves them.
+    fn narrowed_grammar_with(
+        instruction: &str,
+        set: impl FnOnce(&mut crate::PlanOptions),
+    ) -> String {
         let m = map();
+        let mut ctx = PlanContext::new(&m);
+        set(&mut ctx.options);
         let mut v = Vocabulary::for_map(&m);
         v.map_colours(&m);
-        narrow_to_words(&mut v, instruction, &PlanContext::new(&m));
+        narrow_to_words(&mut v, instruction, &ctx);
         answer_lark(&v)
     }
 
@@ -2265,17 +2275,8 @@ mod tests {
         // Held-out v10 (dev) ka05's form on flat-a, whose dining room holds tables and
         // chairs: the room said after the chair is not the table's.
         let said = "the table closest to the red sofa. Then the third chair, and then into the dining room";
-        let on = {
-            let m = map();
-            let mut ctx = PlanContext::new(&m);
-            ctx.options.regions_of_said = true;
-            let mut v = Vocabulary::for_map(&m);
-            v.map_colours(&m);
-            narrow_to_words(&mut v, said, &ctx);
-            answer_lark(&v)
-        };
         grammar::tests::assert_offers(
-            &on,
+            &narrowed_grammar_with(said, |o| o.regions_of_said = true),
             one_pick,
             &[
                 r#""chair", #{ordinal: 3, region: "dining room"}"#,
@@ -2287,14 +2288,8 @@ mod tests {
             ],
         );
         // Off (the default until judged): any pick may take the room said.
-        let m = map();
-        let mut ctx = PlanContext::new(&m);
-        ctx.options.regions_of_said = false;
-        let mut v = Vocabulary::for_map(&m);
-        v.map_colours(&m);
-        narrow_to_words(&mut v, said, &ctx);
         grammar::tests::assert_offers(
-            &answer_lark(&v),
+            &narrowed_grammar(said),
             one_pick,
             &[r#""table", #{region: "dining room"}"#],
             &[],
@@ -2307,17 +2302,9 @@ mod tests {
         let said = "the chair closest to the red sofa, then the table";
         // With every colour of the map offered (`said_colours` off), red is not among
         // the chair's.
-        let m = map();
-        let mut ctx = PlanContext::new(&m);
-        ctx.options.said_colours = false;
-        let all_colours = |said: &str, ctx: &PlanContext<'_>| {
-            let mut v = Vocabulary::for_map(&m);
-            v.map_colours(&m);
-            narrow_to_words(&mut v, said, ctx);
-            answer_lark(&v)
-        };
+        let all_colours = |said: &str| narrowed_grammar_with(said, |o| o.said_colours = false);
         grammar::tests::assert_offers(
-            &all_colours(said, &ctx),
+            &all_colours(said),
             one_pick,
             &[
                 r#""chair", #{near: get_obj("sofa", #{colour: "red"})}"#,
@@ -2334,7 +2321,7 @@ mod tests {
             "the red chair closest to the red sofa",
             "the chair closest to the red sofa, the red one",
         ] {
-            for g in [all_colours(said, &ctx), narrowed_grammar(said)] {
+            for g in [all_colours(said), narrowed_grammar(said)] {
                 grammar::tests::assert_offers(&g, one_pick, &[r#""chair", #{colour: "red"}"#], &[]);
             }
         }
@@ -2354,9 +2341,11 @@ mod tests {
             ],
         );
         // Off: as before.
-        ctx.options.colours_of_others = false;
         grammar::tests::assert_offers(
-            &all_colours("the chair closest to the red sofa", &ctx),
+            &narrowed_grammar_with("the chair closest to the red sofa", |o| {
+                o.said_colours = false;
+                o.colours_of_others = false;
+            }),
             one_pick,
             &[r#""chair", #{colour: "red"}"#],
             &[],
