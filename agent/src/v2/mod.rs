@@ -398,8 +398,8 @@ fn narrow_anchors(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str,
 /// names ([`check::colour_said_only_of`]): "the wheelchair closest to the blue hospital
 /// bed" offers the wheelchair no blue. Its check is `check_colours_of_others`, whose
 /// re-ask bar ([`check::Bar::UnsaidColours`]) leaves out the colours never said as
-/// well; a first answer keeps those (narrowed to the said colours, the first answers
-/// measured worse: see [`narrow_to_words`]). Held-out v10 (dev since its third run)
+/// well; a first answer keeps those unless `said_colours` (the default since stop 72)
+/// narrows it to the said colours too (see [`narrow_to_words`]). Held-out v10 (dev since its third run)
 /// ka05: the default model wrote the wheelchair `#{colour: "blue"}` and left the
 /// hospital bed out, in the first answer and after the re-ask.
 fn narrow_colours_of_others(
