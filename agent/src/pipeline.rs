@@ -128,6 +128,13 @@ pub struct PlanOptions {
     /// default model that began `move_to_object(` meaning that object went on with
     /// another and lost a task (hw06) that the check and its re-ask alone kept.
     pub side_stops_of_said: bool,
+    /// With `said_only`, outside a conversation: where the first thing the person names
+    /// is a side stop ("Plant yourself on the north side of the white dispatch desk.
+    /// Then ..."), the plan's first step must be that side move of that object
+    /// (`check::side_said_first`; default on since stop 73, `--first-side-free` turns it
+    /// off). Measured on held-out v10 and v11 (dev, stop 73): their 12 such tasks went
+    /// from 6 to 11 right.
+    pub first_side_stop: bool,
     /// With `said_only`, outside a conversation: `move_between_the_two` may name only
     /// an object the person said in the plural ("between the two red stools"; default
     /// on; `--pairs-anywhere` turns it off).
@@ -216,6 +223,7 @@ impl Default for PlanOptions {
             counts_of_said: true,
             far_ends_of_said: true,
             side_stops_of_said: false,
+            first_side_stop: true,
             pairs_of_said: true,
             orders_of_said: true,
             anchors_of_said: true,

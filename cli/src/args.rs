@@ -313,6 +313,12 @@ pub(crate) struct ModelArgs {
     /// after a missing side move (off by default: measured worse on held-out v9, dev).
     #[arg(long)]
     pub(crate) side_stops_barred: bool,
+    /// Leave the plan's first step free where the first thing the person names is a
+    /// side stop ("stop on the north side of the white desk, then ..."); by default
+    /// (since stop 73) it must be that side move of that object. For comparison: the
+    /// checks then re-ask a plain stop there.
+    #[arg(long)]
+    pub(crate) first_side_free: bool,
     /// Let the re-ask write its whole answer again, not only from the first step a
     /// finding disputes (the default before stop 69; for comparison).
     #[arg(long)]
@@ -405,6 +411,7 @@ impl ModelArgs {
             counts_of_said: !self.counts_anywhere,
             far_ends_of_said: !self.far_end_anywhere,
             side_stops_of_said: self.side_stops_barred,
+            first_side_stop: !self.first_side_free,
             reask_holds_agreed: !self.reask_whole,
             pairs_of_said: !self.pairs_anywhere,
             orders_of_said: !self.any_direction,

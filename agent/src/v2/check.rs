@@ -3005,6 +3005,32 @@ pub(crate) fn sides_said_of_once(map: &IvlMap, instruction: &str, pose: Pose) ->
     out
 }
 
+/// The side stop ([`side_moves_said`]) the person asks for at the first map name they
+/// say (a room the robot is already in, said first, is skipped:
+/// [`start_room_named_first`]), of an object they name only there: "Plant yourself on
+/// the north side of the white dispatch desk. Then the gear locker, ..." is
+/// `(Side::North, "dispatch desk")`, so the plan's first step is that side move
+/// (`Vocabulary::first_side`). `None` where the first name is a room, an object with no
+/// side said of it, or one named again.
+pub(crate) fn side_said_first(
+    map: &IvlMap,
+    instruction: &str,
+    pose: Pose,
+) -> Option<(Side, String)> {
+    let w = words(instruction);
+    let start = start_room_named_first(map, &w, pose);
+    let (_, first) = name_mentions(map, &w, pose)
+        .into_iter()
+        .find(|(_, n)| Some(n) != start.as_ref())?;
+    if !sides_said_of_once(map, instruction, pose).contains(&first) {
+        return None;
+    }
+    side_moves_said(map, &w, pose)
+        .into_iter()
+        .find(|s| s.of.as_ref() == Some(&first))
+        .map(|s| (s.side, first))
+}
+
 /// The label of the object a step's argument stands for, where it names one.
 fn step_object_label(map: &IvlMap, plan: &TypedPlan, o: &Object, pose: Pose) -> Option<String> {
     match (picked(plan, o), o) {
@@ -4449,6 +4475,42 @@ pub(crate) mod tests {
                 "{said}: {f:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_side_stop_said_of_the_first_name_is_found_only_there() {
+        let m = map();
+        let first = |s: &str| side_said_first(&m, s, m.start_pose);
+        let of = |side: Side, label: &str| Some((side, label.to_string()));
+        assert_eq!(
+            first("Stop to the left of the black sofa, then the tv"),
+            of(Side::Left, "sofa")
+        );
+        assert_eq!(
+            first("Position yourself on the north side of the white bed. Then the fridge."),
+            of(Side::North, "bed")
+        );
+        // The room the robot is in, said first, says where it starts.
+        assert_eq!(
+            first("From the living room: park on the south side of the bed, then the tv"),
+            of(Side::South, "bed")
+        );
+        // The first name is another object, or a room to go into first.
+        assert_eq!(
+            first("go to the tv, then stop to the left of the sofa"),
+            None
+        );
+        assert_eq!(
+            first("go into the kitchen and stop on the north side of the fridge"),
+            None
+        );
+        // The object is named again, or no side is said of it.
+        assert_eq!(
+            first("stop to the left of the sofa, then the tv, then the sofa again"),
+            None
+        );
+        assert_eq!(first("the sofa, then to the left of the tv"), None);
+        assert_eq!(first("go to the chair to the left of the table"), None);
     }
 
     #[test]

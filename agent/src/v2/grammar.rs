@@ -141,6 +141,22 @@ pub struct Vocabulary {
     /// (`v2::follow_objects`). Empty: no such hold, and the grammar is the same as
     /// without the field.
     pub from_start_of: Vec<String>,
+    /// The plan's first step must be this side move of an object of these names: the
+    /// first thing the person named is a side stop ("Plant yourself on the north side of
+    /// the white dispatch desk. Then ...": `move_north(...)` of a dispatch desk). `None`
+    /// (or no name left on offer): no such hold, and the grammar is the same as without
+    /// the field.
+    pub first_side: Option<FirstSide>,
+}
+
+/// A first step the plan must make ([`Vocabulary::first_side`]).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct FirstSide {
+    /// The side move: a registered step function ([`planner_dsl::typed::Side::function`]).
+    pub function: String,
+    /// The names its object may be picked by (a label's names); those the vocabulary
+    /// does not offer, or bars from stops ([`Vocabulary::no_stops`]), are left out.
+    pub names: Vec<String>,
 }
 
 /// The step function of a plain stop at an object ([`Step::GoTo`](planner_dsl::typed::Step::GoTo)),
@@ -263,6 +279,7 @@ impl Vocabulary {
             no_goto: Vec::new(),
             no_positions: false,
             from_start_of: Vec::new(),
+            first_side: None,
         }
     }
 
@@ -1385,6 +1402,25 @@ enum Part {
     Plan,
 }
 
+/// The first step [`Vocabulary::first_side`] holds a plan to: its side move and the
+/// names on offer for its object. `None` where the function is no step function, or no
+/// name is left.
+fn first_side(vocab: &Vocabulary) -> Option<(&str, Vec<String>)> {
+    let f = vocab.first_side.as_ref()?;
+    if !STEP_FUNCTIONS.contains(&f.function.as_str())
+        || call_rule(&f.function, "fobj", true).is_none()
+    {
+        return None;
+    }
+    let names: Vec<String> = f
+        .names
+        .iter()
+        .filter(|n| vocab.names.contains(n) && !vocab.no_stops.contains(n))
+        .cloned()
+        .collect();
+    (!names.is_empty()).then_some((f.function.as_str(), names))
+}
+
 fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     let mut w = Writer::new(d);
     // Statements are separated (not ended) by newlines, as in the worked examples, so
@@ -1411,12 +1447,20 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     } else {
         "stmtn (\"\\n\" stmtn){0,15} | (stmtn \"\\n\"){0,15} letstmt (\"\\n\" stmt){0,15}"
     };
+    // A first step the plan must make (`first_side`): that step, then the statements
+    // as above (at least one where a move back is required), or nothing more.
+    let first = first_side(vocab);
+    let stmts = match (&first, vocab.return_required) {
+        (None, _) => stmts.to_string(),
+        (Some(_), true) => format!("firstside \"\\n\" ({stmts})"),
+        (Some(_), false) => format!("firstside (\"\\n\" ({stmts}))?"),
+    };
     match part {
         Part::Whole => {
             w.rule("root", &format!("objects \"\\nplan:\\n\" ({stmts})"));
             objects_rules(&mut w, vocab, &map_names(vocab));
         }
-        Part::Plan => w.rule("root", stmts),
+        Part::Plan => w.rule("root", &stmts),
     }
     // What a statement may follow (`stmt`, and `stmt_nr` and `ret` below).
     let comment = if vocab.comments {
@@ -1567,6 +1611,30 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             &format!("{p}pick | {p}qname | var{inst}"),
         );
         w.rule(&format!("{p}objn"), &format!("{p}pick | {p}qname{inst}"));
+    }
+    // The first step a plan must make (`first_side`): its side move of a pick or a bare
+    // name of its names, each pick with its group's selection.
+    if let Some((function, names)) = &first {
+        let others: Vec<String> = vocab
+            .names
+            .iter()
+            .filter(|n| !names.contains(n))
+            .cloned()
+            .collect();
+        let fpick = match &groups {
+            Some(groups) if !groups.is_empty() => named_selections_but(groups, "", &others)
+                .into_iter()
+                .map(|(_, names_sel)| format!("{get} {names_sel} \")\""))
+                .collect::<Vec<_>>()
+                .join(" | "),
+            _ => format!("{get} fpname (\", \" selmap)? \")\""),
+        };
+        w.rule("fpick", &fpick);
+        w.rule("fpname", &alt(names, true));
+        w.rule("fobj", "fpick | fpname");
+        if let Some(call) = call_rule(function, "fobj", pairs) {
+            w.rule("firstside", &format!("{comment}{call} \";\""));
+        }
     }
     // An anchor (`near:`) is never a variable: it is written inside a pick, where the
     // grammar does not know whether a `let` came before.
@@ -2434,6 +2502,66 @@ pub(crate) mod tests {
             // A bar that would leave no name to stop at bars nothing.
             v.no_stops = v.names.clone();
             assert_eq!(answer_lark(&v), before);
+        }
+    }
+
+    #[test]
+    fn a_first_side_stop_is_the_first_step_and_only_that() {
+        let plan = |steps: &str| {
+            format!("objects: [(sofa, None, red), (chair, None, None)]\nplan:\n{steps}")
+        };
+        for (grouped, back) in [(false, false), (true, false), (false, true), (true, true)] {
+            let mut v = vocab();
+            v.return_required = back;
+            if grouped {
+                v.colours_of = Some(vec![
+                    (vec!["chair".into()], vec!["black".into()]),
+                    (vec!["sofa".into(), "couch".into()], vec!["red".into()]),
+                ]);
+            }
+            let before = answer_lark(&v);
+            v.first_side = Some(FirstSide {
+                function: "move_north".into(),
+                names: vec!["sofa".into(), "couch".into()],
+            });
+            let lark = answer_lark(&v);
+            assert_ne!(lark, before);
+            let end = if back { "\nmove_to_start();" } else { "" };
+            let with_end = |p: &str| format!("{p}{end}");
+            let ok: Vec<String> = [
+                "move_north(get_obj(\"sofa\", #{colour: \"red\"}));\nmove_to_object(get_obj(\"chair\"));",
+                "move_north(\"couch\");\nlet c = get_obj(\"chair\");\nmove_to_object(c);",
+                "move_north(get_obj(\"couch\"));",
+            ]
+            .iter()
+            .map(|p| with_end(p))
+            .collect();
+            let barred: Vec<String> = [
+                "move_to_object(get_obj(\"sofa\"));",
+                "move_to_object(get_obj(\"chair\"));\nmove_north(get_obj(\"sofa\"));",
+                "move_south(get_obj(\"sofa\"));",
+                "move_north(get_obj(\"chair\"));",
+                "let s = get_obj(\"sofa\");\nmove_north(s);",
+            ]
+            .iter()
+            .map(|p| with_end(p))
+            .collect();
+            let ok: Vec<&str> = ok.iter().map(String::as_str).collect();
+            let barred: Vec<&str> = barred.iter().map(String::as_str).collect();
+            assert_offers(&lark, plan, &ok, &barred);
+            if back {
+                assert_offers(&lark, plan, &[], &["move_north(get_obj(\"sofa\"));"]);
+            }
+            let g = answer_grammar(&v);
+            assert!(undefined_rules(&g).is_empty(), "{:?}", undefined_rules(&g));
+            // The plan alone (a continuation) is held the same way.
+            assert!(lark_accepts(&plan_lark(&v), &with_end("move_north(\"sofa\");")).is_ok());
+            assert!(lark_accepts(&plan_lark(&v), &with_end("move_to_object(\"sofa\");")).is_err());
+            // With no name of it on offer (or barred from stops), nothing is held.
+            v.no_stops = vec!["sofa".into(), "couch".into()];
+            let barred_only = answer_lark(&v);
+            v.first_side = None;
+            assert_eq!(barred_only, answer_lark(&v));
         }
     }
 

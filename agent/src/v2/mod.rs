@@ -342,6 +342,9 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
         if ctx.options.side_stops_of_said && ctx.earlier.is_none() {
             narrow_side_stops(v, ctx.map, instruction, ctx.pose());
         }
+        if ctx.options.first_side_stop && ctx.earlier.is_none() {
+            hold_first_side(v, ctx.map, instruction, ctx.pose());
+        }
         if ctx.options.pairs_of_said && ctx.earlier.is_none() {
             narrow_pairs(v, instruction);
         }
@@ -488,6 +491,14 @@ fn narrow_regions_of_said(
             .iter()
             .find(|(l, _)| l == label)
             .map_or(&[], |(_, r)| r.as_slice());
+        let keys = v.region_keys.as_deref().unwrap_or(&all);
+        let lost: Vec<&String> = list
+            .iter()
+            .filter(|r| keys.contains(r) && !of.contains(r))
+            .collect();
+        if !lost.is_empty() {
+            tracing::debug!(%label, ?lost, "rooms said, but not of this object, are not offered to its picks");
+        }
         list.retain(|r| of.contains(r));
         list
     }));
@@ -506,6 +517,24 @@ fn narrow_regions_of_said(
 fn narrow_side_stops(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str, pose: Pose) {
     let labels = check::sides_said_of_once(map, instruction, pose);
     v.no_goto = names_of_labels(v, map, &labels, pose);
+}
+
+/// Holds the plan's first step to the side move the person asked for at the first
+/// thing they named ([`check::side_said_first`]: "Plant yourself on the north side of
+/// the white dispatch desk. Then ..." begins `move_north(` a dispatch desk), where
+/// [`crate::PlanOptions::first_side_stop`] is on. A constraint, where barring the plain
+/// stop alone ([`narrow_side_stops`]) let the model that began `move_to_object(` go on
+/// with another object. Held-out v11 (dev, stop 72): la06, la12 and lc06 began with a
+/// plain stop at the object of such a side stop, and each re-ask, with that stop
+/// barred, left the object out.
+fn hold_first_side(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str, pose: Pose) {
+    if let Some((side, label)) = check::side_said_first(map, instruction, pose) {
+        tracing::debug!(function = side.function(), %label, "the first step is held to the side stop said first");
+        v.first_side = Some(grammar::FirstSide {
+            function: side.function().to_string(),
+            names: names_of_labels(v, map, &[label], pose),
+        });
+    }
 }
 
 /// The names of `v` that name one of `labels` on `map`.
@@ -1031,6 +1060,8 @@ fn held_answer(
     if held.returns {
         v.return_required = false;
     }
+    // The kept steps hold the first one.
+    v.first_side = None;
     continue_plan(backend, req, held.prefix.clone(), &v, ctx, timing)
 }
 
@@ -2235,6 +2266,8 @@ mod tests {
         let barring = |s: &str| {
             let mut ctx = PlanContext::new(&m);
             ctx.options.side_stops_of_said = true;
+            // This bar alone, without the first step held (`first_side_stop`).
+            ctx.options.first_side_stop = false;
             let mut v = Vocabulary::for_map(&m);
             v.map_colours(&m);
             narrow_to_words(&mut v, s, &ctx);
@@ -2292,6 +2325,44 @@ mod tests {
             &narrowed_grammar(said),
             one_pick,
             &[r#""table", #{region: "dining room"}"#],
+            &[],
+        );
+    }
+
+    #[test]
+    fn a_side_stop_said_first_is_the_plans_first_step() {
+        let said = "Stop on the north side of the black sofa, then the tv";
+        let plan = |steps: &str| {
+            format!("objects: [(sofa, None, black), (tv, None, None)]\nplan:\n{steps}")
+        };
+        let side = "move_north(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_object(get_obj(\"tv\"));";
+        let plain = "move_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_object(get_obj(\"tv\"));";
+        let other = "move_to_object(get_obj(\"tv\"));\nmove_north(get_obj(\"sofa\", #{colour: \"black\"}));";
+        grammar::tests::assert_offers(
+            &narrowed_grammar_with(said, |o| o.first_side_stop = true),
+            plan,
+            &[side],
+            &[plain, other],
+        );
+        // Off (`--first-side-free`): the checks find a plain stop, and re-ask.
+        grammar::tests::assert_offers(
+            &narrowed_grammar_with(said, |o| o.first_side_stop = false),
+            plan,
+            &[side, plain, other],
+            &[],
+        );
+        // On by default.
+        grammar::tests::assert_offers(&narrowed_grammar(said), plan, &[side], &[plain]);
+        // Said of another object than the first named: nothing is held.
+        grammar::tests::assert_offers(
+            &narrowed_grammar_with(
+                "the tv, then stop on the north side of the black sofa",
+                |o| {
+                    o.first_side_stop = true;
+                },
+            ),
+            plan,
+            &[other],
             &[],
         );
     }
