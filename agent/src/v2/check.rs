@@ -2250,16 +2250,28 @@ pub(crate) fn said_of(
             out.extend(named[i].iter().cloned());
             continue;
         }
-        let before = named[..i].iter().rev().find(|l| !l.is_empty());
-        let after = named[i + 1..].iter().find(|l| !l.is_empty());
-        if before.is_none() && after.is_none() {
+        let near = nearest_named(&named, i);
+        if near.is_empty() {
             return None;
         }
-        out.extend(before.into_iter().chain(after).flatten().cloned());
+        out.extend(near.into_iter().cloned());
     }
     out.sort();
     out.dedup();
     any.then_some(out)
+}
+
+/// The labels of the nearest clauses before and after clause `i` that name one (`named`:
+/// each clause's labels, [`named_in`]): whose [`said_of`] and [`regions_said_of`] take
+/// what a clause naming no object says. Empty where no other clause names one.
+fn nearest_named(named: &[Vec<String>], i: usize) -> Vec<&String> {
+    let before = named[..i].iter().rev().find(|l| !l.is_empty());
+    let after = named
+        .get(i + 1..)
+        .into_iter()
+        .flatten()
+        .find(|l| !l.is_empty());
+    before.into_iter().chain(after).flatten().collect()
 }
 
 /// The labels named in the words `w` of a clause, in order (`name_at`: the label a name
@@ -2360,9 +2372,7 @@ pub(crate) fn regions_said_of(
         if regions.is_empty() || !named[i].is_empty() {
             continue;
         }
-        let before = named[..i].iter().rev().find(|l| !l.is_empty());
-        let after = named[i + 1..].iter().find(|l| !l.is_empty());
-        for l in before.into_iter().chain(after).flatten() {
+        for l in nearest_named(&named, i) {
             add(l, regions);
         }
     }

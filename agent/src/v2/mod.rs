@@ -423,10 +423,15 @@ fn narrow_colours_of_others(
 /// The colours `v` offers a pick of map label `label`: its group's list in
 /// [`Vocabulary::colours_of`] under any of its names, else all of `v`'s colours.
 fn offered_colours(v: &Vocabulary, label: &str) -> Vec<String> {
+    label_group(v.colours_of.as_deref(), label).unwrap_or_else(|| v.colours.clone())
+}
+
+/// The list `groups` gives map label `label` under any of its names
+/// ([`grammar::group_list`]): `None` where no group holds one of them.
+fn label_group<T: Clone>(groups: Option<&[(Vec<String>, T)]>, label: &str) -> Option<T> {
     grammar::label_names(label.to_string())
         .iter()
-        .find_map(|n| grammar::group_list(v.colours_of.as_deref(), n))
-        .unwrap_or_else(|| v.colours.clone())
+        .find_map(|n| grammar::group_list(groups, n))
 }
 
 /// Offers what `what` selects with only to the names of the objects the person said it
@@ -483,10 +488,7 @@ fn narrow_regions_of_said(
     let current = v.regions_of.take();
     let all = v.regions.clone();
     v.regions_of = Some(grammar::name_groups(map, |label| {
-        let mut list = grammar::label_names(label.to_string())
-            .iter()
-            .find_map(|n| grammar::group_list(current.as_deref(), n))
-            .unwrap_or_else(|| all.clone());
+        let mut list = label_group(current.as_deref(), label).unwrap_or_else(|| all.clone());
         let of: &[String] = said
             .iter()
             .find(|(l, _)| l == label)
