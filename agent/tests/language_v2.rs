@@ -321,8 +321,13 @@ fn a_reask_after_an_unsaid_colour_has_a_grammar_that_bars_it() {
     // colours: `agent::v2`'s unit test `a_reask_bars_the_unsaid_colours_of_the_label_a_finding_names`).
     assert_ne!(reqs[1].lark, reqs[0].lark);
     assert_ne!(reqs[1].grammar, reqs[0].grammar);
-    // A finding that bars nothing (a said colour left out) keeps the first grammar.
-    let (_, reqs) = plan_scripted_opts(&[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT], said, all_colours);
+    // A finding that bars nothing (a said colour of no name left out: "the sofa that's
+    // black") keeps the first grammar.
+    let (_, reqs) = plan_scripted_opts(
+        &[BLACK_SOFA_WRONG, BLACK_SOFA_RIGHT],
+        "take me to the sofa that's black",
+        all_colours,
+    );
     assert_eq!(reqs[1].lark, reqs[0].lark);
     assert_eq!(reqs[1].grammar, reqs[0].grammar);
     // By default the first grammar offers the sofa only the said colour, so a backend

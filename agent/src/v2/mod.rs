@@ -1764,7 +1764,9 @@ mod tests {
     fn a_reask_bars_the_unsaid_colours_of_the_label_a_finding_names() {
         let m = map();
         let v = Vocabulary::for_map(&m);
-        let instruction = "go to the chair, the yellow one, then the grey couch";
+        // "that's yellow": a colour said of no name ("the chair, the yellow one" says
+        // it of the chair, and its dropped-colour bar would win).
+        let instruction = "go to the chair that's yellow, then the grey couch";
         let f = first_findings(
             &m,
             instruction,
@@ -2392,7 +2394,7 @@ mod tests {
         // Said of the chair too, or once of no name, it is offered.
         for said in [
             "the red chair closest to the red sofa",
-            "the chair closest to the red sofa, the red one",
+            "the chair closest to the red sofa, then the red one",
         ] {
             for g in [all_colours(said), narrowed_grammar(said)] {
                 grammar::tests::assert_offers(&g, one_pick, &[r#""chair", #{colour: "red"}"#], &[]);
