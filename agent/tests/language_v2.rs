@@ -849,3 +849,22 @@ fn with_regions_of_said_a_room_said_of_another_object_is_reasked() {
     assert!(out.plan().is_some(), "{out:?}");
     assert_eq!(reqs.len(), 1);
 }
+
+#[test]
+fn a_reask_that_keeps_the_side_stop_said_first_does_not_ask_for_it_again() {
+    // The first step is held to the side stop said first (`PlanOptions::first_side_stop`);
+    // the re-ask after a finding about the second step keeps the first step, so its
+    // grammar, for what follows, holds no first step.
+    let said = "stop on the north side of the black sofa, then the tv";
+    let first = "objects: [(sofa, None, black), (tv, None, None)]\nplan:\nmove_north(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_object(get_obj(\"tv\", #{colour: \"black\"}));\n";
+    let rest = "move_to_object(get_obj(\"tv\"));\n";
+    let (out, reqs) = plan_scripted(&[first, rest], said);
+    let p = out.plan().expect("a plan after the re-ask");
+    assert!(p.script.starts_with("agent.move_north("), "{}", p.script);
+    assert_eq!(reqs.len(), 2);
+    assert!(reqs[0].lark.as_deref().unwrap().contains("firstside"));
+    let kept = reqs[1].messages.last().unwrap();
+    assert_eq!(kept.role, Role::Assistant);
+    assert!(kept.content.contains("move_north("), "{}", kept.content);
+    assert!(!reqs[1].lark.as_deref().unwrap().contains("firstside"));
+}
