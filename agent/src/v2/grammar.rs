@@ -1402,23 +1402,45 @@ enum Part {
     Plan,
 }
 
-/// The first step [`Vocabulary::first_side`] holds a plan to: its side move and the
-/// names on offer for its object. `None` where the function is no step function, or no
-/// name is left.
-fn first_side(vocab: &Vocabulary) -> Option<(&str, Vec<String>)> {
+/// The first step [`Vocabulary::first_side`] holds a plan to: its side move's call rule,
+/// on the object rule `fobj`, and the names on offer for that object. `None` where the
+/// function is no step function, or no name is left.
+fn first_side(vocab: &Vocabulary) -> Option<(String, Vec<String>)> {
     let f = vocab.first_side.as_ref()?;
-    if !STEP_FUNCTIONS.contains(&f.function.as_str())
-        || call_rule(&f.function, "fobj", true).is_none()
-    {
+    if !STEP_FUNCTIONS.contains(&f.function.as_str()) {
         return None;
     }
+    // A side move takes an object, never a name with a selection (`namesel`), so
+    // whether pairs are offered does not matter to it.
+    let call = call_rule(&f.function, "fobj", true)?;
     let names: Vec<String> = f
         .names
         .iter()
         .filter(|n| vocab.names.contains(n) && !vocab.no_stops.contains(n))
         .cloned()
         .collect();
-    (!names.is_empty()).then_some((f.function.as_str(), names))
+    (!names.is_empty()).then_some((call, names))
+}
+
+/// The body of the rule `{p}pick`: a pick (`get`) of a name of the vocabulary less
+/// `but`. With pick groups, each group's kept names with its selection (the group's
+/// own rule `pick{g}` where it keeps them all); without, `{p}pname` (the kept names)
+/// with the shared selection.
+fn picks_but(groups: Option<&[PickGroup]>, get: &str, but: &[String], p: &str) -> String {
+    match groups {
+        Some(groups) if !groups.is_empty() => named_selections_but(groups, "", but)
+            .into_iter()
+            .map(|(g, names_sel)| {
+                if groups[g].names.iter().any(|n| but.contains(n)) {
+                    format!("{get} {names_sel} \")\"")
+                } else {
+                    format!("pick{g}")
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(" | "),
+        _ => format!("{get} {p}pname (\", \" selmap)? \")\""),
+    }
 }
 
 fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
@@ -1571,30 +1593,14 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 picks.push(format!("pick{g}"));
             }
             w.rule("pick", &picks.join(" | "));
-            for (p, list) in &barring {
-                let kept: Vec<String> = named_selections_but(groups, "", list)
-                    .into_iter()
-                    .map(|(g, names_sel)| {
-                        let all = &groups[g].names;
-                        if all.iter().any(|n| list.contains(n)) {
-                            format!("{get} {names_sel} \")\"")
-                        } else {
-                            format!("pick{g}")
-                        }
-                    })
-                    .collect();
-                w.rule(&format!("{p}pick"), &kept.join(" | "));
-            }
         }
-        _ => {
-            w.rule("pick", &format!("{get} pname (\", \" selmap)? \")\""));
-            for (p, _) in &barring {
-                w.rule(
-                    &format!("{p}pick"),
-                    &format!("{get} {p}pname (\", \" selmap)? \")\""),
-                );
-            }
-        }
+        _ => w.rule("pick", &format!("{get} pname (\", \" selmap)? \")\"")),
+    }
+    for (p, list) in &barring {
+        w.rule(
+            &format!("{p}pick"),
+            &picks_but(groups.as_deref(), &get, list, p),
+        );
     }
     for (p, list) in &barring {
         let kept: Vec<&String> = vocab.names.iter().filter(|n| !list.contains(n)).collect();
@@ -1614,27 +1620,17 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     }
     // The first step a plan must make (`first_side`): its side move of a pick or a bare
     // name of its names, each pick with its group's selection.
-    if let Some((function, names)) = &first {
+    if let Some((call, names)) = &first {
         let others: Vec<String> = vocab
             .names
             .iter()
             .filter(|n| !names.contains(n))
             .cloned()
             .collect();
-        let fpick = match &groups {
-            Some(groups) if !groups.is_empty() => named_selections_but(groups, "", &others)
-                .into_iter()
-                .map(|(_, names_sel)| format!("{get} {names_sel} \")\""))
-                .collect::<Vec<_>>()
-                .join(" | "),
-            _ => format!("{get} fpname (\", \" selmap)? \")\""),
-        };
-        w.rule("fpick", &fpick);
+        w.rule("fpick", &picks_but(groups.as_deref(), &get, &others, "f"));
         w.rule("fpname", &alt(names, true));
         w.rule("fobj", "fpick | fpname");
-        if let Some(call) = call_rule(function, "fobj", pairs) {
-            w.rule("firstside", &format!("{comment}{call} \";\""));
-        }
+        w.rule("firstside", &format!("{comment}{call} \";\""));
     }
     // An anchor (`near:`) is never a variable: it is written inside a pick, where the
     // grammar does not know whether a `let` came before.
