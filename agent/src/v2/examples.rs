@@ -276,7 +276,7 @@ mod tests {
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let unsaid = super::super::check::unsaid_directions(&e.instruction, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
-            let unsaid = super::super::check::unsaid_sizes(&e.instruction, &a.plan);
+            let unsaid = super::super::check::unsaid_sizes(&e.instruction, None, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);
             let unsaid = super::super::check::unsaid_far_ends(&e.instruction, &a.plan);
             assert!(unsaid.is_empty(), "line {}: {unsaid:?}", e.line);

