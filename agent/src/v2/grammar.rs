@@ -1260,7 +1260,14 @@ fn named_selections_but(groups: &[PickGroup], tag: &str, but: &[String]) -> Vec<
 /// `all` are the shared colour and region rules (none: the map has none).
 ///
 /// A group with anchors of its own ([`PickGroup::anchors`]) gets the rule `anch{suffix}`:
-/// a pick (`get`) of one of those names, with its group in `picks` selecting it.
+/// a pick (`get`) of one of those names, with its group in `picks` selecting it as an
+/// anchor does (`selmapa{g}`, written with `anchor`: no `near:` of its own).
+///
+/// An anchor takes no anchor: held-out v11 (dev, read per task at stop 73) lb05, "the
+/// life ring closest to the yellow deck chair" (each named in the other's clause),
+/// was written `get_obj("deck chair", #{near: get_obj("life ring", #{near:
+/// get_obj("deck chair", ...` to the token limit in all three draws. No instruction of
+/// the dev sets relates an anchor to a third object.
 fn group_rules(
     w: &mut Writer,
     suffix: &str,
@@ -1268,9 +1275,10 @@ fn group_rules(
     (all_colours, all_regions): (Option<&str>, Option<&str>),
     vocab: &Vocabulary,
     ends: OrderEnds,
-    (picks, get): (&[PickGroup], &str),
+    (picks, get, anchor): (&[PickGroup], &str, bool),
 ) {
     let near = match &group.anchors {
+        _ if anchor => None,
         None => Some("objn".to_string()),
         Some(anchors) => {
             let others: Vec<String> = picks
@@ -1279,7 +1287,7 @@ fn group_rules(
                 .filter(|n| !anchors.contains(n))
                 .cloned()
                 .collect();
-            let alternatives: Vec<String> = named_selections_but(picks, "", &others)
+            let alternatives: Vec<String> = named_selections_but(picks, "a", &others)
                 .into_iter()
                 .map(|(_, names_sel)| format!("{get} {names_sel} \")\""))
                 .collect();
@@ -1735,6 +1743,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             (false, false, "", false),
         );
     }
+    let picks = groups.as_deref().unwrap_or_default();
     for (tag, gs) in [("", &groups), ("p", &pair_groups)] {
         for (g, group) in gs.iter().flatten().enumerate() {
             group_rules(
@@ -1744,7 +1753,28 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 (all_colours, all_regions),
                 vocab,
                 group.order_ends(&from_end, &not_from_end).2,
-                (groups.as_deref().unwrap_or_default(), &get),
+                (picks, &get, false),
+            );
+        }
+    }
+    // The selections of the groups some group's `anch` rule picks (`selmapa{g}`).
+    let anchored: Vec<&String> = [&groups, &pair_groups]
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|g| g.anchors.as_ref())
+        .flatten()
+        .collect();
+    for (g, group) in picks.iter().enumerate() {
+        if group.names.iter().any(|n| anchored.contains(&n)) {
+            group_rules(
+                &mut w,
+                &format!("a{g}"),
+                group,
+                (all_colours, all_regions),
+                vocab,
+                group.order_ends(&from_end, &not_from_end).2,
+                (picks, &get, true),
             );
         }
     }

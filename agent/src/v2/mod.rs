@@ -2014,6 +2014,20 @@ mod tests {
                 r#""table", #{near: get_obj("sofa")}"#,
             ],
         );
+        // An anchor takes no anchor of its own, even where each is named in the other's
+        // clause (held-out v11, dev, lb05 nested them to the token limit).
+        grammar::tests::assert_offers(
+            &narrowed_grammar("the chair closest to the black sofa"),
+            one_pick,
+            &[
+                r#""chair", #{near: get_obj("sofa", #{colour: "black"})}"#,
+                r#""sofa", #{near: get_obj("chair")}"#,
+            ],
+            &[
+                r#""chair", #{near: get_obj("sofa", #{near: get_obj("chair")})}"#,
+                r#""sofa", #{near: get_obj("chair", #{near: get_obj("sofa")})}"#,
+            ],
+        );
         // Not narrowed in a conversation, nor with `--anchors-anywhere`.
         assert!(narrowed(said, &[9]).anchors_of.is_none());
         let m = map();
