@@ -1969,6 +1969,45 @@ pub(crate) fn said_in_plural<'a>(names: &'a [String], instruction: &str) -> Vec<
         .collect()
 }
 
+/// The objects the person asks to stop between two of, as design.md's "between the two
+/// yellow tables" says it: "between" and, one or two words after it, "two" or "both"
+/// before a name of the map in the plural ([`said_in_plural`]; colour words may come
+/// between: "halfway between the two red ball racks"), where that is the only time the
+/// person names that object ([`name_mentions`]). Their labels, once each. "Between the
+/// two red chairs, then the black chair" names the chair again, and "between the sofa
+/// and the two chairs" has no "two" right after "between": neither is one.
+pub(crate) fn pairs_said_between(map: &IvlMap, instruction: &str, pose: Pose) -> Vec<String> {
+    let w = words(instruction);
+    let mentions: Vec<Option<String>> = name_mentions(map, &w, pose)
+        .into_iter()
+        .map(|(_, n)| object_label(map, &n, pose))
+        .collect();
+    let mut out: Vec<String> = Vec::new();
+    for (i, x) in w.iter().enumerate() {
+        if !matches!(x.as_str(), "between" | "inbetween") {
+            continue;
+        }
+        let Some(two) = (i + 1..=i + 2)
+            .find(|&j| matches!(w.get(j).map(String::as_str), Some("two" | "both" | "2")))
+        else {
+            continue;
+        };
+        let Some((_, label)) = noun_after(map, &w, two, pose) else {
+            continue;
+        };
+        let names = crate::v2::grammar::label_names(label.clone());
+        let once = mentions
+            .iter()
+            .filter(|l| l.as_ref() == Some(&label))
+            .count()
+            == 1;
+        if once && !said_in_plural(&names, instruction).is_empty() && !out.contains(&label) {
+            out.push(label);
+        }
+    }
+    out
+}
+
 /// A finding for each `move_between_the_two` of a name the person did not say in the
 /// plural under any of its names ([`said_in_plural`]): "between the piano and the
 /// black microphone" is a stop between two objects, not "the two microphones". The
@@ -3447,6 +3486,34 @@ pub(crate) mod tests {
             "/../examples/scenes/flat-a.scene.json"
         );
         IvlMap::from_scene(&map_core::scene::Scene::from_path(path).unwrap())
+    }
+
+    #[test]
+    fn a_stop_between_the_two_of_a_name_said_once_is_read() {
+        let m = map();
+        let pose = m.start_pose;
+        let said = |s: &str| pairs_said_between(&m, s, pose);
+        assert_eq!(
+            said("stop between the two yellow tables, then the fridge"),
+            ["table"]
+        );
+        assert_eq!(
+            said("Waypoint 1: the gap between the two yellow tables."),
+            ["table"]
+        );
+        assert_eq!(
+            said("go to the fridge, then halfway between both couches"),
+            ["sofa"]
+        );
+        for not in [
+            "stop between the two red chairs, then the black chair",
+            "stop between the sofa and the two chairs",
+            "stop between the red sofa and the black one",
+            "go to the two tables",
+            "stop between the two tables and the sofa, then the table by the tv",
+        ] {
+            assert!(said(not).is_empty(), "{not}");
+        }
     }
 
     #[test]

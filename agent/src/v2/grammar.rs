@@ -118,10 +118,12 @@ pub struct Vocabulary {
     /// `v2/mod.rs`). The plan's selections are not narrowed by this.
     pub tuple_colours: Option<Vec<String>>,
     /// Names the plan may not stop at, face or bind with `let`, only pick another object
-    /// near (`near:`): a re-ask after an object the person named once, only to pick out
-    /// another, that the first answer also stopped at
-    /// ([`check::Bar::AnchorStop`](super::check::Bar::AnchorStop)). Empty: no such bar,
-    /// and the grammar is the same as without the field.
+    /// near (`near:`) or stop between two of (`move_between_the_two`): a re-ask after an
+    /// object the person named once, only to pick out another, that the first answer
+    /// also stopped at ([`check::Bar::AnchorStop`](super::check::Bar::AnchorStop)), and
+    /// the objects the person asks to stop between two of ("between the two red ball
+    /// racks", `hold_pairs` in `v2/mod.rs`). Empty: no such bar, and the grammar is the
+    /// same as without the field.
     pub no_stops: Vec<String>,
     /// Names `move_to_object` may not take, nor a `let` bind; a side move, a face or an
     /// anchor may still: a re-ask after a side stop the person asked for that the plan
