@@ -1746,17 +1746,20 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         );
     }
     let picks = groups.as_deref().unwrap_or_default();
+    let write_group = |w: &mut Writer, suffix: String, group: &PickGroup, anchor: bool| {
+        group_rules(
+            w,
+            &suffix,
+            group,
+            (all_colours, all_regions),
+            vocab,
+            group.order_ends(&from_end, &not_from_end).2,
+            (picks, &get, anchor),
+        );
+    };
     for (tag, gs) in [("", &groups), ("p", &pair_groups)] {
         for (g, group) in gs.iter().flatten().enumerate() {
-            group_rules(
-                &mut w,
-                &format!("{tag}{g}"),
-                group,
-                (all_colours, all_regions),
-                vocab,
-                group.order_ends(&from_end, &not_from_end).2,
-                (picks, &get, false),
-            );
+            write_group(&mut w, format!("{tag}{g}"), group, false);
         }
     }
     // The selections of the groups some group's `anch` rule picks (`selmapa{g}`).
@@ -1769,15 +1772,7 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         .collect();
     for (g, group) in picks.iter().enumerate() {
         if group.names.iter().any(|n| anchored.contains(&n)) {
-            group_rules(
-                &mut w,
-                &format!("a{g}"),
-                group,
-                (all_colours, all_regions),
-                vocab,
-                group.order_ends(&from_end, &not_from_end).2,
-                (picks, &get, true),
-            );
+            write_group(&mut w, format!("a{g}"), group, true);
         }
     }
     let (positive, negative) = ordinal_signs(vocab);
