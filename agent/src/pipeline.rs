@@ -142,9 +142,11 @@ pub struct PlanOptions {
     /// With `said_only`, outside a conversation: an object the person asks to stop
     /// between two of, and names nowhere else ("the gap between the two pink party
     /// tables": `check::pairs_said_between`), may be no stop of the plan's but
-    /// `move_between_the_two`'s (default on since stop 74; `--between-the-two-free`
-    /// turns it off).
-    pub between_the_two_held: bool,
+    /// `move_between_the_two`'s. Default off (`--pair-stops-barred` turns it on):
+    /// measured at stop 74 on the 29 dev tasks that say "between the two", the default
+    /// model that began `move_in_between(` then took other objects, and two tasks right
+    /// before were lost (lc05, mc05); none was gained.
+    pub pair_stops_barred: bool,
     /// With `said_only`: a pick may count only in the directional orders the person's
     /// words count in (`check::directions_said`: "the second to last seat from the
     /// west" in `east_to_west`, "the westernmost shelf" in `west_to_east`), where every
@@ -231,7 +233,7 @@ impl Default for PlanOptions {
             side_stops_of_said: false,
             first_side_stop: true,
             pairs_of_said: true,
-            between_the_two_held: true,
+            pair_stops_barred: false,
             orders_of_said: true,
             anchors_of_said: true,
             colours_of_others: true,

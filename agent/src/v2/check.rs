@@ -3144,6 +3144,23 @@ pub(crate) fn side_said_first(
         .map(|s| (s.side, first))
 }
 
+/// The object the person asks to stop between two of ([`pairs_said_between`]: "the gap
+/// between the two pink party tables", named only there) where that is the first map
+/// name they say (a room the robot is already in, said first, is skipped:
+/// [`start_room_named_first`]): the plan's first step is then `move_between_the_two` of
+/// it (`Vocabulary::first_side`), as [`side_said_first`]'s is a side move.
+pub(crate) fn pair_said_first(map: &IvlMap, instruction: &str, pose: Pose) -> Option<String> {
+    let w = words(instruction);
+    let start = start_room_named_first(map, &w, pose);
+    let (_, first) = name_mentions(map, &w, pose)
+        .into_iter()
+        .find(|(_, n)| Some(n) != start.as_ref())?;
+    let first = object_label(map, &first, pose)?;
+    pairs_said_between(map, instruction, pose)
+        .contains(&first)
+        .then_some(first)
+}
+
 /// The label of the object a step's argument stands for, where it names one.
 fn step_object_label(map: &IvlMap, plan: &TypedPlan, o: &Object, pose: Pose) -> Option<String> {
     match (picked(plan, o), o) {

@@ -716,6 +716,12 @@ fn takes_position(name: &str) -> bool {
 /// ([`Vocabulary::pairs_of`]); without `pairs` (no name has two objects) such a
 /// function is left out. `None` when the registry does not hold it, or it is left out.
 fn call_rule(name: &str, obj: &str, pairs: bool) -> Option<String> {
+    call_rule_with(name, obj, pairs.then_some("namesel"))
+}
+
+/// [`call_rule`] with the rule of a name and its selection (`namesel`: `None` where no
+/// pair is offered).
+fn call_rule_with(name: &str, obj: &str, namesel: Option<&str>) -> Option<String> {
     let f = planner_dsl::lookup(name)?;
     let mut r = q(&format!("{name}("));
     let mut first = true;
@@ -727,11 +733,8 @@ fn call_rule(name: &str, obj: &str, pairs: bool) -> Option<String> {
         let rule = if p.ty == ParamType::Name
             && params.peek().is_some_and(|n| n.ty == ParamType::Selection)
         {
-            if !pairs {
-                return None;
-            }
             params.next();
-            "namesel"
+            namesel?
         } else {
             arg_rule(p.ty, obj)
         };
@@ -1412,21 +1415,37 @@ enum Part {
     Plan,
 }
 
+/// The function of a stop between the two objects of a name that match
+/// (`move_between_the_two(name, selection)`), which [`Vocabulary::first_side`] may hold.
+const PAIR_FUNCTION: &str = "move_between_the_two";
+
 /// The first step [`Vocabulary::first_side`] holds a plan to: its side move's call rule,
-/// on the object rule `fobj`, and the names on offer for that object. `None` where the
-/// function is no step function, or no name is left.
+/// on the object rule `fobj` (for [`PAIR_FUNCTION`], on the name and selection rule
+/// `fnamesel`), and the names on offer for that object. `None` where the function is no
+/// step function, or no name is left.
 fn first_side(vocab: &Vocabulary) -> Option<(String, Vec<String>)> {
     let f = vocab.first_side.as_ref()?;
     if !STEP_FUNCTIONS.contains(&f.function.as_str()) {
         return None;
     }
+    let pair = f.function == PAIR_FUNCTION;
     // A side move takes an object, never a name with a selection (`namesel`), so
     // whether pairs are offered does not matter to it.
-    let call = call_rule(&f.function, "fobj", true)?;
+    let call = call_rule_with(
+        &f.function,
+        "fobj",
+        Some(if pair { "fnamesel" } else { "namesel" }),
+    )?;
+    // A pair's names are those `move_between_the_two` may name.
+    let paired = |n: &String| {
+        !pair
+            || pick_groups(vocab, true)
+                .is_none_or(|groups| groups.iter().any(|g| g.names.contains(n)))
+    };
     let names: Vec<String> = f
         .names
         .iter()
-        .filter(|n| vocab.names.contains(n) && !vocab.no_stops.contains(n))
+        .filter(|n| vocab.names.contains(n) && !vocab.no_stops.contains(n) && paired(n))
         .cloned()
         .collect();
     (!names.is_empty()).then_some((call, names))
@@ -1637,9 +1656,26 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             .filter(|n| !names.contains(n))
             .cloned()
             .collect();
-        w.rule("fpick", &picks_but(groups.as_deref(), &get, &others, "f"));
         w.rule("fpname", &alt(names, true));
-        w.rule("fobj", "fpick | fpname");
+        if vocab
+            .first_side
+            .as_ref()
+            .is_some_and(|f| f.function == PAIR_FUNCTION)
+        {
+            // The name and its pair selection, as `namesel` has them.
+            let namesel = match &pair_groups {
+                Some(groups) if !groups.is_empty() => named_selections_but(groups, "p", &others)
+                    .into_iter()
+                    .map(|(_, s)| s)
+                    .collect::<Vec<_>>()
+                    .join(" | "),
+                _ => "fpname (\", \" selmap)?".to_string(),
+            };
+            w.rule("fnamesel", &namesel);
+        } else {
+            w.rule("fpick", &picks_but(groups.as_deref(), &get, &others, "f"));
+            w.rule("fobj", "fpick | fpname");
+        }
         w.rule("firstside", &format!("{comment}{call} \";\""));
     }
     // An anchor (`near:`) is never a variable: it is written inside a pick, where the
