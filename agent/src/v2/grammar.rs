@@ -1429,8 +1429,9 @@ fn first_side(vocab: &Vocabulary) -> Option<(String, Vec<String>)> {
         return None;
     }
     let pair = f.function == PAIR_FUNCTION;
-    // A side move takes an object, never a name with a selection (`namesel`), so
-    // whether pairs are offered does not matter to it.
+    // A side move takes an object (`fobj`), never a name with a selection, so whether
+    // pairs are offered does not matter to it; a pair takes X's names and their pair
+    // selection (`fnamesel`).
     let call = call_rule_with(
         &f.function,
         "fobj",
