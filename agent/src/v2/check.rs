@@ -3118,6 +3118,17 @@ pub(crate) fn sides_said_of_once(map: &IvlMap, instruction: &str, pose: Pose) ->
     out
 }
 
+/// The first map name the words `w` say ([`name_mentions`]), past a room the robot is
+/// already in, said first ([`start_room_named_first`]): what [`side_said_first`] and
+/// [`pair_said_first`] hold the plan's first step to.
+fn first_name_said(map: &IvlMap, w: &[String], pose: Pose) -> Option<String> {
+    let start = start_room_named_first(map, w, pose);
+    name_mentions(map, w, pose)
+        .into_iter()
+        .map(|(_, n)| n)
+        .find(|n| Some(n) != start.as_ref())
+}
+
 /// The side stop ([`side_moves_said`]) the person asks for at the first map name they
 /// say (a room the robot is already in, said first, is skipped:
 /// [`start_room_named_first`]), of an object they name only there: "Plant yourself on
@@ -3131,10 +3142,7 @@ pub(crate) fn side_said_first(
     pose: Pose,
 ) -> Option<(Side, String)> {
     let w = words(instruction);
-    let start = start_room_named_first(map, &w, pose);
-    let (_, first) = name_mentions(map, &w, pose)
-        .into_iter()
-        .find(|(_, n)| Some(n) != start.as_ref())?;
+    let first = first_name_said(map, &w, pose)?;
     if !sides_said_of_once(map, instruction, pose).contains(&first) {
         return None;
     }
@@ -3150,11 +3158,7 @@ pub(crate) fn side_said_first(
 /// [`start_room_named_first`]): the plan's first step is then `move_between_the_two` of
 /// it (`Vocabulary::first_side`), as [`side_said_first`]'s is a side move.
 pub(crate) fn pair_said_first(map: &IvlMap, instruction: &str, pose: Pose) -> Option<String> {
-    let w = words(instruction);
-    let start = start_room_named_first(map, &w, pose);
-    let (_, first) = name_mentions(map, &w, pose)
-        .into_iter()
-        .find(|(_, n)| Some(n) != start.as_ref())?;
+    let first = first_name_said(map, &words(instruction), pose)?;
     let first = object_label(map, &first, pose)?;
     pairs_said_between(map, instruction, pose)
         .contains(&first)
@@ -3407,20 +3411,17 @@ pub fn check_answer_after(
             format!("the plan picks the {} with ordinal {}, counted from the far end, but the person spoke of the far end only for the {of}: leave the {}'s ordinal out (nearest first) unless their words about it count from far away", t.name, t.ordinal, t.name)
         }
     };
+    let name_words = object_name_words(map);
     let unsaid: [(Vec<&Target>, &Note<'_>, &str); 9] = [
         (
             unsaid_directions(&allowed, plan),
             &directions,
             ", counting from where",
         ),
-        (
-            unsaid_sizes(&allowed, Some(&object_name_words(map)), plan),
-            &sizes,
-            "",
-        ),
+        (unsaid_sizes(&allowed, Some(&name_words), plan), &sizes, ""),
         (unsaid_far_ends(&allowed, plan), &far_ends, ""),
         (
-            unsaid_regions(&allowed, &object_name_words(map), in_chat, plan),
+            unsaid_regions(&allowed, &name_words, in_chat, plan),
             &regions,
             "",
         ),

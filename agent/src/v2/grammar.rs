@@ -1417,7 +1417,7 @@ enum Part {
 
 /// The function of a stop between the two objects of a name that match
 /// (`move_between_the_two(name, selection)`), which [`Vocabulary::first_side`] may hold.
-const PAIR_FUNCTION: &str = "move_between_the_two";
+pub(crate) const PAIR_FUNCTION: &str = "move_between_the_two";
 
 /// The first step [`Vocabulary::first_side`] holds a plan to: its side move's call rule,
 /// on the object rule `fobj` (for [`PAIR_FUNCTION`], on the name and selection rule

@@ -578,7 +578,7 @@ fn hold_first_side(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str
     let (function, label) = match check::side_said_first(map, instruction, pose) {
         Some((side, label)) => (side.function(), label),
         None => match check::pair_said_first(map, instruction, pose) {
-            Some(label) => ("move_between_the_two", label),
+            Some(label) => (grammar::PAIR_FUNCTION, label),
             None => return,
         },
     };
