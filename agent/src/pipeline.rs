@@ -152,6 +152,17 @@ pub struct PlanOptions {
     /// west" in `east_to_west`, "the westernmost shelf" in `west_to_east`), where every
     /// word naming a direction is read so (default on; `--any-direction` turns it off).
     pub orders_of_said: bool,
+    /// With no map (extraction), an object on the objects line is made of the person's
+    /// own words and their singulars ([`crate::v2::grammar::Vocabulary::object_words`]).
+    /// Off: any word (the default before stop 75; for comparison).
+    pub said_object_words: bool,
+    /// With `reask_holds_agreed`: the re-ask's answer, continued after the steps it keeps,
+    /// writes at least as many steps as the first answer made from its first disputed
+    /// place on that no finding is about, and one for that place (`v2::Held::later`).
+    /// Read in dev logs at stop 75, a re-ask about one step often ended the plan there
+    /// (four steps became one).
+    /// Default on (`--reask-may-shorten` turns it off).
+    pub reask_keeps_steps: bool,
     /// With `said_only`, outside a conversation: a pick may be picked near (`near:`)
     /// only an object the person named in a clause with it (`check::anchors_said`;
     /// default on; `--anchors-anywhere` turns it off).
@@ -235,6 +246,8 @@ impl Default for PlanOptions {
             pairs_of_said: true,
             pair_stops_barred: false,
             orders_of_said: true,
+            said_object_words: true,
+            reask_keeps_steps: true,
             anchors_of_said: true,
             colours_of_others: true,
             reask_keeps_return: true,

@@ -195,6 +195,35 @@ fn a_reask_keeps_the_steps_before_the_first_disputed_one() {
     assert_eq!(reqs[1].messages.len(), reqs[0].messages.len());
 }
 
+#[test]
+fn a_reask_writes_at_least_the_steps_no_finding_disputes() {
+    let instruction =
+        "go to the kitchen, then to the black sofa, then the bedroom, then the office";
+    let objects = "objects: [(kitchen, None, None), (sofa, None, black), (bedroom, None, None), (office, None, None)]\nplan:\n";
+    let first = format!("{objects}move_to_object(\"kitchen\");\nmove_to_object(get_obj(\"sofa\"));\nmove_to_object(\"bedroom\");\nmove_to_object(\"office\");\n");
+    let rest = "move_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_object(\"bedroom\");\nmove_to_object(\"office\");";
+    let (out, reqs) = plan_scripted(&[&first, rest], instruction);
+    assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 1 });
+    // The disputed sofa and the two steps after it: at least three statements.
+    let floor = "stmtn (\"\\n\" stmtn){2,15}";
+    let g = reqs[1].grammar.as_deref().unwrap();
+    assert!(g.contains(floor), "{g}");
+    assert!(reqs[1].lark.as_deref().unwrap().contains("{2,15}"));
+    // `--reask-may-shorten`: no floor.
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let b = Scripted::new(&[&first, rest]);
+    let mut ctx = v2(&map, &robot);
+    ctx.options.reask_keeps_steps = false;
+    let out = plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
+    assert!(out.plan().is_some());
+    let g = b.requests()[1].grammar.clone().unwrap();
+    assert!(
+        !g.contains("{2,15}") && g.contains("stmtn (\"\\n\" stmtn){0,15}"),
+        "{g}"
+    );
+}
+
 /// [`plan_scripted`] for a plan that must end moving back to the start after `repairs`
 /// re-asks or draws, the first re-ask noting `noted`; the requests made.
 fn returns_after_reask(

@@ -341,6 +341,15 @@ pub(crate) struct ModelArgs {
     /// default before stop 71; for comparison).
     #[arg(long)]
     pub(crate) reask_may_drop_return: bool,
+    /// Let the re-ask's answer end before the first answer's later steps that no finding
+    /// disputes (the default before stop 75; for comparison).
+    #[arg(long)]
+    pub(crate) reask_may_shorten: bool,
+    /// Let an object on the objects line of an extraction case be made of any word, not
+    /// only the person's words and their singulars (the default before stop 75; for
+    /// comparison).
+    #[arg(long)]
+    pub(crate) any_object_words: bool,
     /// Let a tuple on the objects line carry any colour word, not only a colour the
     /// person said (the default before stop 51; for comparison).
     #[arg(long)]
@@ -422,6 +431,8 @@ impl ModelArgs {
             pairs_of_said: !self.pairs_anywhere,
             pair_stops_barred: self.pair_stops_barred,
             orders_of_said: !self.any_direction,
+            said_object_words: !self.any_object_words,
+            reask_keeps_steps: !self.reask_may_shorten,
             anchors_of_said: !self.anchors_anywhere,
             colours_of_others: !self.colours_of_others_allowed,
             reask_keeps_return: !self.reask_may_drop_return,

@@ -209,6 +209,22 @@ pub fn first_disputed_step(
     plan: &TypedPlan,
     pose: Pose,
 ) -> Option<usize> {
+    disputed_steps(map, instruction, findings, plan, pose)?
+        .into_iter()
+        .min()
+}
+
+/// The place in `plan` of each of `findings`, as [`first_disputed_step`] places them
+/// (a step a finding is about, or where a step the plan lacks would go), in the order of
+/// `findings`; `None` where a finding is about no place. Empty where there is no finding.
+#[must_use]
+pub fn disputed_steps(
+    map: &IvlMap,
+    instruction: &str,
+    findings: &[Finding],
+    plan: &TypedPlan,
+    pose: Pose,
+) -> Option<Vec<usize>> {
     let labels = |s: &Step| step_labels(map, s, pose);
     let mentions: Vec<String> = name_mentions(map, &words(instruction), pose)
         .into_iter()
@@ -233,7 +249,7 @@ pub fn first_disputed_step(
             agreed
         })
     };
-    let mut first: Option<usize> = None;
+    let mut out = Vec::new();
     for f in findings {
         let about = f.about.as_ref()?;
         match (f.kind, about) {
@@ -251,9 +267,9 @@ pub fn first_disputed_step(
             },
             About::Missing(l) => missing(l)?,
         };
-        first = Some(first.map_or(at, |k| k.min(at)));
+        out.push(at);
     }
-    first
+    Some(out)
 }
 
 /// The labels a step picks, in the order a person names them: each target's, then its

@@ -33,8 +33,8 @@ use self::answer::{objects_part, parse_answer, Answer};
 use self::check::{check_answer_after, runtime_finding, Finding, FindingKind};
 use self::grammar::{
     answer_grammar, answer_lark, answer_objects_grammar, answer_objects_lark, group_list,
-    label_names, name_groups, objects_grammar, objects_lark, plan_grammar, plan_lark, words_said,
-    Vocabulary,
+    label_names, name_groups, object_words_said, objects_grammar, objects_lark, plan_grammar,
+    plan_lark, words_said, Vocabulary,
 };
 
 /// The messages of one request: system (+ scene), the nearest worked examples, the
@@ -112,6 +112,9 @@ pub fn extract(
 fn extract_vocabulary(instruction: &str, options: &crate::PlanOptions) -> Vocabulary {
     let mut vocab = Vocabulary {
         said_words: words_said(instruction),
+        object_words: options
+            .said_object_words
+            .then(|| object_words_said(instruction)),
         ..Vocabulary::default()
     };
     if options.said_tuple_colours {
@@ -1029,6 +1032,10 @@ struct Held {
     steps: usize,
     /// Whether a kept step moves back to the start.
     returns: bool,
+    /// How many steps the continuation writes at least ([`Vocabulary::min_steps`], with
+    /// [`crate::PlanOptions::reask_keeps_steps`]): the answer's steps from the first
+    /// disputed place on that no finding is about, and one for that place.
+    later: usize,
 }
 
 /// What the re-ask after `findings` keeps of the answer `text`: its objects line and its
@@ -1044,8 +1051,19 @@ fn held_prefix(
     ctx: &PlanContext<'_>,
 ) -> Option<Held> {
     let answer = parse_answer(text).ok()?;
-    let disputed =
-        check::first_disputed_step(ctx.map, instruction, findings, &answer.plan, ctx.pose())?;
+    let places = check::disputed_steps(ctx.map, instruction, findings, &answer.plan, ctx.pose())?;
+    let disputed = places.iter().copied().min()?;
+    // The steps from the first disputed place on that no finding is about, and one for
+    // that place: the step it mends, or the one it lacks; none where a finding there
+    // bars a stop the plan made at an anchor (that stop goes).
+    let goes = findings
+        .iter()
+        .zip(&places)
+        .any(|(f, p)| *p == disputed && matches!(f.bar, Some(check::Bar::AnchorStop { .. })));
+    let later = (disputed..answer.plan.steps.len())
+        .filter(|i| !places.contains(i))
+        .count()
+        + usize::from(!goes);
     let steps = answer
         .plan
         .steps
@@ -1089,6 +1107,7 @@ fn held_prefix(
         tuples: answer.tuples,
         steps,
         returns,
+        later,
     })
 }
 
@@ -1115,6 +1134,9 @@ fn held_answer(
     }
     // The kept steps hold the first one.
     v.first_side = None;
+    if ctx.options.reask_keeps_steps {
+        v.min_steps = held.later;
+    }
     continue_plan(backend, req, held.prefix.clone(), &v, ctx, timing)
 }
 
@@ -1420,6 +1442,50 @@ mod tests {
         let lark = objects_lark(&extract_vocabulary(south, &open));
         let line = "objects: [(cabinet, last, None, south_to_north)]\n";
         assert!(grammar::tests::lark_accepts(&lark, line).is_ok());
+    }
+
+    #[test]
+    fn an_extracted_object_is_made_of_the_persons_words() {
+        let options = crate::PlanOptions::default();
+        let accepts = |instruction: &str, line: &str| {
+            let lark = objects_lark(&extract_vocabulary(instruction, &options));
+            grammar::tests::lark_accepts(&lark, &format!("objects: [{line}]\n")).is_ok()
+        };
+        // A word that begins with a colour word ("tank": "tan") in a name of two words
+        // (held-out v12, dev, mx17 and mx29 were `fermentationtank`).
+        let tank = "the fermentation tank, the white one";
+        assert!(accepts(tank, "(fermentation tank, None, white)"));
+        assert!(!accepts(tank, "(fermentationtank, None, white)"));
+        assert!(!accepts(tank, "(tank, None, None), (table, None, white)"));
+        // A colour word is no object, nor is one word that begins with a side.
+        assert!(!accepts(tank, "(white, None, None)"));
+        let west = "of the ball returns, the one furthest west, then the pro shop";
+        assert!(!accepts(west, "(west, None, None)"));
+        // Plural or singular; up to three words.
+        assert!(accepts(
+            west,
+            "(ball return, 1, None, west_to_east), (pro shop, None, None)"
+        ));
+        assert!(accepts(west, "(ball returns, None, None)"));
+        assert!(accepts(
+            "the big red fire engine bay",
+            "(fire engine bay, None, red)"
+        ));
+        assert!(!accepts(
+            "the big red fire engine bay",
+            "(the fire engine bay, None, red)"
+        ));
+        // Off: any word.
+        let any = crate::PlanOptions {
+            said_object_words: false,
+            ..crate::PlanOptions::default()
+        };
+        let lark = objects_lark(&extract_vocabulary(tank, &any));
+        let line = "objects: [(fermentationtank, None, white)]\n";
+        assert!(grammar::tests::lark_accepts(&lark, line).is_ok());
+        // GBNF is built from the same words.
+        let gbnf = objects_grammar(&extract_vocabulary(tank, &options));
+        assert!(gbnf.contains("oword"), "{gbnf}");
     }
 
     #[test]
