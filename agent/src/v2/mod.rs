@@ -118,7 +118,12 @@ fn extract_vocabulary(instruction: &str, options: &crate::PlanOptions) -> Vocabu
         ..Vocabulary::default()
     };
     if options.said_tuple_colours {
-        vocab.tuple_colours = Some(said_tuple_colours(&vocab, instruction, &[]));
+        // A colour said only to leave it out is no tuple's (formats.md: "the X that
+        // isn't yellow" has colour null).
+        let kept = check::kept_colour_said(instruction);
+        let mut colours = said_tuple_colours(&vocab, instruction, &[]);
+        colours.retain(|c| kept(c));
+        vocab.tuple_colours = Some(colours);
     }
     if options.said_only {
         vocab.ordinals = Some(said_ordinals(instruction));
@@ -1483,6 +1488,20 @@ mod tests {
         let lark = objects_lark(&extract_vocabulary(tank, &any));
         let line = "objects: [(fermentationtank, None, white)]\n";
         assert!(grammar::tests::lark_accepts(&lark, line).is_ok());
+        // A colour said only to leave it out is no tuple's.
+        let apart = "any lunch table apart from the brown one, then the red chair";
+        assert!(accepts(
+            apart,
+            "(lunch table, None, None), (chair, None, red)"
+        ));
+        assert!(!accepts(
+            apart,
+            "(lunch table, None, brown), (chair, None, red)"
+        ));
+        assert!(accepts(
+            "a table that isn't blue, then the blue one",
+            "(table, None, None), (table, None, blue)"
+        ));
         // GBNF is built from the same words.
         let gbnf = objects_grammar(&extract_vocabulary(tank, &options));
         assert!(gbnf.contains("oword"), "{gbnf}");
