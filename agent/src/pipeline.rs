@@ -156,6 +156,10 @@ pub struct PlanOptions {
     /// own words and their singulars ([`crate::v2::grammar::Vocabulary::object_words`]).
     /// Off: any word (the default before stop 75; for comparison).
     pub said_object_words: bool,
+    /// With no map (extraction): where the person puts an object in a place ("the till in
+    /// the snack bar") that no tuple of the answer lists (`check::places_unlisted`), one
+    /// re-ask naming the words. Default on (`--no-extraction-reask` turns it off).
+    pub extraction_reask: bool,
     /// With `reask_holds_agreed`: the re-ask's answer, continued after the steps it keeps,
     /// writes at least as many steps as the first answer made from its first disputed
     /// place on that no finding is about, and one for that place (`v2::Held::later`).
@@ -247,6 +251,7 @@ impl Default for PlanOptions {
             pair_stops_barred: false,
             orders_of_said: true,
             said_object_words: true,
+            extraction_reask: true,
             reask_keeps_steps: true,
             anchors_of_said: true,
             colours_of_others: true,

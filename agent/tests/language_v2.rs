@@ -224,6 +224,37 @@ fn a_reask_writes_at_least_the_steps_no_finding_disputes() {
     );
 }
 
+#[test]
+fn an_extraction_that_lists_no_place_said_is_reasked_once() {
+    let instruction = "the till in the snack bar, then the bridge";
+    let first = "objects: [(till, None, None), (bridge, None, None)]\n";
+    let second = "objects: [(till, None, None), (snack bar, None, None), (bridge, None, None)]\n";
+    let listed = |answers: &[&str], options: &PlanOptions| {
+        let b = Scripted::new(answers);
+        let (tuples, _) =
+            agent::v2::extract(&b, &Prompts::builtin(), instruction, options).unwrap();
+        let objects: Vec<String> = tuples.into_iter().map(|t| t.object).collect();
+        (objects, b.requests())
+    };
+    let (objects, reqs) = listed(&[first, second], &PlanOptions::default());
+    assert_eq!(objects, ["till", "snack bar", "bridge"]);
+    assert_eq!(reqs.len(), 2);
+    let note = &reqs[1].messages.last().unwrap().content;
+    assert!(note.contains("\"in the snack bar\""), "{note}");
+    assert_eq!(reqs[1].grammar, reqs[0].grammar);
+    // One re-ask only: an answer that still lists no place stands.
+    let (objects, reqs) = listed(&[first, first], &PlanOptions::default());
+    assert_eq!(objects, ["till", "bridge"]);
+    assert_eq!(reqs.len(), 2);
+    // Listed at first: no re-ask; `--no-extraction-reask`: none either.
+    assert_eq!(listed(&[second], &PlanOptions::default()).1.len(), 1);
+    let off = PlanOptions {
+        extraction_reask: false,
+        ..PlanOptions::default()
+    };
+    assert_eq!(listed(&[first], &off).0, ["till", "bridge"]);
+}
+
 /// [`plan_scripted`] for a plan that must end moving back to the start after `repairs`
 /// re-asks or draws, the first re-ask noting `noted`; the requests made.
 fn returns_after_reask(

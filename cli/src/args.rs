@@ -345,6 +345,11 @@ pub(crate) struct ModelArgs {
     /// disputes (the default before stop 75; for comparison).
     #[arg(long)]
     pub(crate) reask_may_shorten: bool,
+    /// Take an extraction case's first objects line as it is, with no re-ask for a place
+    /// the person put an object in that it lists no word of (the default before stop 75;
+    /// for comparison).
+    #[arg(long)]
+    pub(crate) no_extraction_reask: bool,
     /// Let an object on the objects line of an extraction case be made of any word, not
     /// only the person's words and their singulars (the default before stop 75; for
     /// comparison).
@@ -432,6 +437,7 @@ impl ModelArgs {
             pair_stops_barred: self.pair_stops_barred,
             orders_of_said: !self.any_direction,
             said_object_words: !self.any_object_words,
+            extraction_reask: !self.no_extraction_reask,
             reask_keeps_steps: !self.reask_may_shorten,
             anchors_of_said: !self.anchors_anywhere,
             colours_of_others: !self.colours_of_others_allowed,

@@ -94,11 +94,32 @@ pub fn extract(
     let c = backend.complete(&req)?;
     let mut timing = Timing::default();
     timing.add(&c);
-    let text = objects_part(&c.text).map_or(c.text.as_str(), |(_, t)| t);
-    let tuples = parse_tuples(text).map_err(|source| LanguageError::Tuples {
+    let read = |text: &str| parse_tuples(objects_part(text).map_or(text, |(_, t)| t));
+    let mut tuples = read(&c.text).map_err(|source| LanguageError::Tuples {
         source,
         answer: c.text.clone(),
     })?;
+    // A place the person put an object in that no tuple lists: one re-ask naming the
+    // words (as a plan's re-ask is made); its answer stands where it reads.
+    let unlisted = check::places_unlisted(instruction, &tuples);
+    if options.extraction_reask && !unlisted.is_empty() {
+        tracing::debug!(answer = %c.text, ?unlisted, "objects line lacks a place; re-asking once");
+        let notes: Vec<String> = unlisted
+            .iter()
+            .map(|p| {
+                format!("the person said \"{p}\", but the objects line lists no such place: if it names a room or a place, list it too, in the order said")
+            })
+            .collect();
+        let reask = prompts.v2_reask(&notes)?;
+        if let Some(last) = req.messages.last_mut() {
+            last.content = format!("{}\n{}", last.content, reask.content);
+        }
+        let again = backend.complete(&req)?;
+        timing.add(&again);
+        if let Ok(t) = read(&again.text) {
+            tuples = t;
+        }
+    }
     timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
     Ok((tuples, timing))
 }
