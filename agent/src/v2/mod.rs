@@ -104,9 +104,16 @@ pub fn extract(
     let unlisted = check::places_unlisted(instruction, &tuples);
     if options.extraction_reask && !unlisted.is_empty() {
         tracing::debug!(answer = %c.text, ?unlisted, "objects line lacks a place; re-asking once");
+        // The first such place's word is required of some object on the re-ask's line.
+        if options.answer_grammar {
+            let mut vocab = extract_vocabulary(instruction, options);
+            vocab.object_word_required = unlisted.first().map(|(_, w)| w.clone());
+            req.grammar = Some(objects_grammar(&vocab));
+            req.lark = options.llguidance.then(|| objects_lark(&vocab));
+        }
         let notes: Vec<String> = unlisted
             .iter()
-            .map(|p| {
+            .map(|(p, _)| {
                 format!("the person said \"{p}\", but the objects line lists no such place: if it names a room or a place, list it too, in the order said")
             })
             .collect();
@@ -1523,6 +1530,24 @@ mod tests {
             "a table that isn't blue, then the blue one",
             "(table, None, None), (table, None, blue)"
         ));
+        // A word required of some object (a re-ask after a place left out).
+        let kit = "helmet rack in the kit room, please";
+        let mut v = extract_vocabulary(kit, &options);
+        v.object_word_required = Some("kit".into());
+        let lark = objects_lark(&v);
+        let line = |l: &str| grammar::tests::lark_accepts(&lark, &format!("objects: [{l}]\n"));
+        assert!(line("(helmet rack, None, None), (kit room, None, None)").is_ok());
+        assert!(line("(kit room, None, None), (helmet rack, None, None)").is_ok());
+        assert!(line("(helmet rack, None, None)").is_err());
+        assert!(line("").is_err());
+        let g = objects_grammar(&v);
+        assert!(grammar::tests::undefined_rules(&g).is_empty(), "{g}");
+        // Not a word the person said: no hold.
+        v.object_word_required = Some("garage".into());
+        assert_eq!(
+            objects_lark(&v),
+            objects_lark(&extract_vocabulary(kit, &options))
+        );
         // GBNF is built from the same words.
         let gbnf = objects_grammar(&extract_vocabulary(tank, &options));
         assert!(gbnf.contains("oword"), "{gbnf}");
