@@ -2327,7 +2327,7 @@ const IN_A_PLACE: &[&str] = &["in", "on", "inside"];
 /// too; read on held-out v11 and v12 (dev), the default model left out the room of "X
 /// in the Y" in 7 of 8 such cases, although worked examples list it.
 #[must_use]
-pub fn places_unlisted(instruction: &str, tuples: &[Tuple]) -> Vec<(String, String)> {
+pub fn places_unlisted(instruction: &str, tuples: &[Tuple]) -> Vec<PlaceUnlisted> {
     let mut listed: Vec<String> = Vec::new();
     for t in tuples {
         for w in words(&t.object) {
@@ -2335,7 +2335,12 @@ pub fn places_unlisted(instruction: &str, tuples: &[Tuple]) -> Vec<(String, Stri
             listed.push(w);
         }
     }
+    let firsts: Vec<String> = tuples
+        .iter()
+        .filter_map(|t| words(&t.object).into_iter().next())
+        .collect();
     let mut out = Vec::new();
+    let mut before: Vec<String> = Vec::new();
     for c in clauses(instruction) {
         for i in 0..c.len() {
             if !IN_A_PLACE.contains(&c[i].as_str())
@@ -2356,10 +2361,28 @@ pub fn places_unlisted(instruction: &str, tuples: &[Tuple]) -> Vec<(String, Stri
             {
                 continue;
             }
-            out.push((c[i..(j + 3).min(c.len())].join(" "), w.clone()));
+            let said_before = |f: &String| before.contains(f) || c[..i].contains(f);
+            out.push(PlaceUnlisted {
+                phrase: c[i..(j + 3).min(c.len())].join(" "),
+                word: w.clone(),
+                after: firsts.iter().filter(|f| said_before(f)).count(),
+            });
         }
+        before.extend(c);
     }
     out
+}
+
+/// A place the objects line lists no word of ([`places_unlisted`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PlaceUnlisted {
+    /// The person's words from the place word on ("in the kit room").
+    pub phrase: String,
+    /// The first word of the place's name ("kit").
+    pub word: String,
+    /// How many of the tuples name an object (by its first word) said before the place:
+    /// where, in the order of mention, the place's tuple goes.
+    pub after: usize,
 }
 
 /// What a clause may say of the objects it names, and only of those.
@@ -3592,7 +3615,7 @@ pub(crate) mod tests {
         let unlisted = |instruction: &str, line: &str| -> Vec<String> {
             places_unlisted(instruction, &crate::tuples::parse_tuples(line).unwrap())
                 .into_iter()
-                .map(|(phrase, word)| format!("{phrase}/{word}"))
+                .map(|p| format!("{}/{}/{}", p.phrase, p.word, p.after))
                 .collect()
         };
         assert_eq!(
@@ -3600,21 +3623,21 @@ pub(crate) mod tests {
                 "helmet rack in the kit room, please and thank you",
                 "[(helmet rack, None, None)]"
             ),
-            ["in the kit room/kit"]
+            ["in the kit room/kit/1"]
         );
         assert_eq!(
             unlisted(
                 "the till in the snack bar, then the bridge",
                 "[(till, None, None), (bridge, None, None)]"
             ),
-            ["in the snack bar/snack"]
+            ["in the snack bar/snack/1"]
         );
         assert_eq!(
             unlisted(
                 "the luggage rack on the red car deck",
                 "[(luggage rack, None, None)]"
             ),
-            ["on the red car deck/car"]
+            ["on the red car deck/car/1"]
         );
         // Listed (a plural said, a singular listed), or no place.
         for (instruction, line) in [

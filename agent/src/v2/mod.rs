@@ -107,13 +107,17 @@ pub fn extract(
         // The first such place's word is required of some object on the re-ask's line.
         if options.answer_grammar {
             let mut vocab = extract_vocabulary(instruction, options);
-            vocab.object_word_required = unlisted.first().map(|(_, w)| w.clone());
+            if let Some(p) = unlisted.first() {
+                vocab.object_word_required = Some(p.word.clone());
+                vocab.object_word_after = p.after;
+            }
             req.grammar = Some(objects_grammar(&vocab));
             req.lark = options.llguidance.then(|| objects_lark(&vocab));
         }
         let notes: Vec<String> = unlisted
             .iter()
-            .map(|(p, _)| {
+            .map(|u| {
+                let p = &u.phrase;
                 format!("the person said \"{p}\", but the objects line lists no such place: if it names a room or a place, list it too, in the order said")
             })
             .collect();
@@ -1534,10 +1538,17 @@ mod tests {
         let kit = "helmet rack in the kit room, please";
         let mut v = extract_vocabulary(kit, &options);
         v.object_word_required = Some("kit".into());
+        v.object_word_after = 1;
         let lark = objects_lark(&v);
         let line = |l: &str| grammar::tests::lark_accepts(&lark, &format!("objects: [{l}]\n"));
         assert!(line("(helmet rack, None, None), (kit room, None, None)").is_ok());
-        assert!(line("(kit room, None, None), (helmet rack, None, None)").is_ok());
+        // After as many tuples as were said before it (here none).
+        assert!(line("(kit room, None, None), (helmet rack, None, None)").is_err());
+        v.object_word_after = 0;
+        let lark0 = objects_lark(&v);
+        let line0 = |l: &str| grammar::tests::lark_accepts(&lark0, &format!("objects: [{l}]\n"));
+        assert!(line0("(kit room, None, None), (helmet rack, None, None)").is_ok());
+        v.object_word_after = 1;
         assert!(line("(helmet rack, None, None)").is_err());
         assert!(line("").is_err());
         let g = objects_grammar(&v);
