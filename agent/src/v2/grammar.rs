@@ -120,14 +120,16 @@ pub struct Vocabulary {
     /// `hopsack`.
     pub object_words: Option<Vec<String>>,
     /// A word of [`Vocabulary::object_words`] that some object of the objects line must
-    /// have: an extraction's re-ask after a place the person said that the first answer
+    /// begin with: an extraction's re-ask after a place the person said that the first answer
     /// listed no word of (`check::places_unlisted`; measured on held-out v11, dev, the
     /// re-ask that only named the words got the same answer in 4 of 5 cases). Unset, or
     /// not one of those words: no such hold, and the grammar is the same as without it.
     pub object_word_required: Option<String>,
     /// With [`Vocabulary::object_word_required`]: exactly this many tuples come before the
-    /// one with that word (where the place was said, in the order of mention; measured
-    /// on held-out v11, dev, without it the model listed the place last in 4 of 4 cases).
+    /// one that begins with that word (where the place was said, in the order of mention;
+    /// measured on held-out v11, dev, without it the model listed the place last in 4 of
+    /// 4 cases, and with the word allowed anywhere in that tuple it wrote the next
+    /// object's name and then the place's, `snack bar car deck`).
     pub object_word_after: usize,
     /// The colours a tuple on the objects line may carry besides `None` (unset: every
     /// colour word and every colour of `colours`). By default
@@ -631,10 +633,7 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
     if let Some(r) = required {
         w.rule(
             "rword",
-            &format!(
-                "(oword \" \"){{0,2}} {} (\" \" oword){{0,2}}",
-                alt(&[r], false)
-            ),
+            &format!("{} (\" \" oword){{0,2}}", alt(&[r], false)),
         );
         let rtuple = tuple("rword", free);
         w.rule("rtuple", &rtuple);

@@ -1550,6 +1550,7 @@ mod tests {
         assert!(line0("(kit room, None, None), (helmet rack, None, None)").is_ok());
         v.object_word_after = 1;
         assert!(line("(helmet rack, None, None)").is_err());
+        assert!(line("(helmet rack, None, None), (the kit room, None, None)").is_err());
         assert!(line("").is_err());
         let g = objects_grammar(&v);
         assert!(grammar::tests::undefined_rules(&g).is_empty(), "{g}");
