@@ -2321,8 +2321,9 @@ const IN_A_PLACE: &[&str] = &["in", "on", "inside"];
 /// The places `instruction` puts something in ("in the kit room") whose name's first
 /// word (past colour words) no tuple of `tuples` has, each as the person's words from
 /// the place word on (up to three words of the name) and that first word: with no map
-/// (extraction), what a re-ask names and requires. Not a side or a direction ("on the left of", "on the north side"), nor
-/// a part of something ("in the middle of the two desks": "of" within two words).
+/// (extraction), what a re-ask names and requires. Not a side or a direction ("on the
+/// left of", "on the north side"), nor a part of something ("in the middle of the two
+/// desks": "of" within two words).
 /// formats.md's extraction tuples list "every object the instruction mentions", rooms
 /// too; read on held-out v11 and v12 (dev), the default model left out the room of "X
 /// in the Y" in 7 of 8 such cases, although worked examples list it.

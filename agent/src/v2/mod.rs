@@ -84,11 +84,13 @@ pub fn extract(
         options.extract_max_tokens,
     );
     req.stop = vec!["\n".into()];
-    if options.answer_grammar {
-        let vocab = extract_vocabulary(instruction, options);
-        req.grammar = Some(objects_grammar(&vocab));
+    let vocab = options
+        .answer_grammar
+        .then(|| extract_vocabulary(instruction, options));
+    if let Some(vocab) = &vocab {
+        req.grammar = Some(objects_grammar(vocab));
         if options.llguidance {
-            req.lark = Some(objects_lark(&vocab));
+            req.lark = Some(objects_lark(vocab));
         }
     }
     let c = backend.complete(&req)?;
@@ -105,8 +107,7 @@ pub fn extract(
     if options.extraction_reask && !unlisted.is_empty() {
         tracing::debug!(answer = %c.text, ?unlisted, "objects line lacks a place; re-asking once");
         // The first such place's word is required of some object on the re-ask's line.
-        if options.answer_grammar {
-            let mut vocab = extract_vocabulary(instruction, options);
+        if let Some(mut vocab) = vocab {
             if let Some(p) = unlisted.first() {
                 vocab.object_word_required = Some(p.word.clone());
                 vocab.object_word_after = p.after;
@@ -121,10 +122,7 @@ pub fn extract(
                 format!("the person said \"{p}\", but the objects line lists no such place: if it names a room or a place, list it too, in the order said")
             })
             .collect();
-        let reask = prompts.v2_reask(&notes)?;
-        if let Some(last) = req.messages.last_mut() {
-            last.content = format!("{}\n{}", last.content, reask.content);
-        }
+        add_reask(prompts, &mut req.messages, &notes)?;
         let again = backend.complete(&req)?;
         timing.add(&again);
         if let Ok(t) = read(&again.text) {
@@ -133,6 +131,20 @@ pub fn extract(
     }
     timing.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
     Ok((tuples, timing))
+}
+
+/// A re-ask's request: `messages` with the re-ask's `notes` added to the person's last
+/// message ([`Prompts::v2_reask`]), for a plan's re-ask and an extraction's alike.
+fn add_reask(
+    prompts: &Prompts,
+    messages: &mut [ChatMessage],
+    notes: &[String],
+) -> Result<(), LanguageError> {
+    let reask = prompts.v2_reask(notes)?;
+    if let Some(last) = messages.last_mut() {
+        last.content = format!("{}\n{}", last.content, reask.content);
+    }
+    Ok(())
 }
 
 /// The objects line's vocabulary for [`extract`] (no map): the said words, the said
@@ -1019,10 +1031,7 @@ pub fn plan_instruction(
                 // (measured: with the first answer left in the conversation, the model
                 // repeated it word for word under greedy decoding).
                 let notes: Vec<String> = f.iter().map(|x| x.to_model.clone()).collect();
-                let reask = prompts.v2_reask(&notes)?;
-                if let Some(last) = msgs.last_mut() {
-                    last.content = format!("{}\n{}", last.content, reask.content);
-                }
+                add_reask(prompts, &mut msgs, &notes)?;
                 let mut reasked =
                     reask_vocabulary(&vocab, ctx.map, instruction, &known, &f, ctx.pose());
                 if ctx.options.reask_keeps_return && undisputed_return(&c.text, &f) {
