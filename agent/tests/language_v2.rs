@@ -261,6 +261,49 @@ fn an_extraction_that_lists_no_place_said_is_reasked_once() {
     assert_eq!(listed(&[first], &off).0, ["till", "bridge"]);
 }
 
+#[test]
+fn an_extraction_that_lists_a_name_less_a_word_is_reasked_once() {
+    let instruction = "the oak barrel nearest to the blue beer keg, then the barrel room";
+    let first =
+        "objects: [(barrel, None, None), (beer keg, None, blue), (barrel room, None, None)]\n";
+    let second =
+        "objects: [(oak barrel, None, None), (beer keg, None, blue), (barrel room, None, None)]\n";
+    let b = Scripted::new(&[first, second]);
+    let (tuples, _) = agent::v2::extract(
+        &b,
+        &Prompts::builtin(),
+        instruction,
+        &PlanOptions::default(),
+    )
+    .unwrap();
+    let objects: Vec<String> = tuples.into_iter().map(|t| t.object).collect();
+    assert_eq!(objects, ["oak barrel", "beer keg", "barrel room"]);
+    let reqs = b.requests();
+    assert_eq!(reqs.len(), 2);
+    let note = &reqs[1].messages.last().unwrap().content;
+    assert!(
+        note.contains("\"oak barrel\"") && note.contains("(barrel, ...)"),
+        "{note}"
+    );
+    // Its grammar requires the first object to begin with the whole name.
+    let g1 = reqs[1].grammar.clone().unwrap();
+    assert!(g1.contains("rword ::= \"oak barrel\""), "{g1}");
+    assert!(
+        g1.contains("root ::= objects") || g1.contains("objects ::= \"objects: [\" rtuple"),
+        "{g1}"
+    );
+    // Listed whole at first: no re-ask.
+    let b = Scripted::new(&[second]);
+    agent::v2::extract(
+        &b,
+        &Prompts::builtin(),
+        instruction,
+        &PlanOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(b.requests().len(), 1);
+}
+
 /// [`plan_scripted`] for a plan that must end moving back to the start after `repairs`
 /// re-asks or draws, the first re-ask noting `noted`; the requests made.
 fn returns_after_reask(

@@ -200,7 +200,9 @@ impl Finding {
 /// ([`About::Missing`]), the steps stand that pick, in order, what the person named
 /// before it, in the order named ([`name_mentions`]; design.md: the order of mention is
 /// the order of the visits), less the last of them, which the missing object may belong
-/// to ("the swivel chair closest to the white printer" written without the printer).
+/// to ("the swivel chair closest to the white printer" written without the printer),
+/// unless the missing object is the only one its clause ([`clauses`]) names ("then into
+/// triage", "and call it a day in the pro shop"): then a place of its own after them.
 #[must_use]
 pub fn first_disputed_step(
     map: &IvlMap,
@@ -230,6 +232,33 @@ pub fn disputed_steps(
         .into_iter()
         .map(|(_, l)| l)
         .collect();
+    // The labels named in each clause, where they are the instruction's in order.
+    let per_clause: Vec<Vec<String>> = clauses(instruction)
+        .iter()
+        .map(|w| {
+            name_mentions(map, w, pose)
+                .into_iter()
+                .map(|(_, l)| l)
+                .collect()
+        })
+        .collect();
+    let by_clause = (per_clause.concat() == mentions).then_some(per_clause);
+    // Whether the `k`th label named is the only one its clause names ("then into
+    // triage", "and call it a day in the pro shop"): a place of its own, not one of the
+    // object before it.
+    let alone = |k: usize| -> bool {
+        let Some(by_clause) = &by_clause else {
+            return false;
+        };
+        let mut seen = 0;
+        for c in by_clause {
+            if k < seen + c.len() {
+                return c.len() == 1;
+            }
+            seen += c.len();
+        }
+        false
+    };
     // Where the plan lacks `l`: after the steps for what was named before it.
     let missing = |l: &str| -> Option<usize> {
         let named_at = mentions.iter().position(|m| m == l)?;
@@ -243,7 +272,7 @@ pub fn disputed_steps(
             m += ls.len();
             agreed += 1;
         }
-        Some(if m == named_at {
+        Some(if m == named_at && !alone(named_at) {
             agreed.saturating_sub(1)
         } else {
             agreed
@@ -2386,6 +2415,256 @@ pub struct PlaceUnlisted {
     pub after: usize,
 }
 
+/// Articles and the other words that begin a phrase naming an object ("the", "each",
+/// "another"), for [`names_cut`].
+const DETERMINERS: &[&str] = &[
+    "the",
+    "a",
+    "an",
+    "this",
+    "that",
+    "these",
+    "those",
+    "my",
+    "your",
+    "our",
+    "their",
+    "its",
+    "his",
+    "her",
+    "each",
+    "every",
+    "any",
+    "some",
+    "all",
+    "both",
+    "either",
+    "neither",
+    "no",
+    "another",
+    "other",
+    "same",
+    "which",
+    "whichever",
+    "what",
+    "few",
+    "several",
+    "many",
+];
+
+/// Words that are no part of an object's name, for [`names_cut`] (with
+/// [`DETERMINERS`]): pronouns, prepositions, the words that join or end a request, and the
+/// words of courtesy. (Counts, colours, sizes, directions and superlatives are read by
+/// their own rules.)
+const FUNCTION_WORDS: &[&str] = &[
+    "to",
+    "from",
+    "of",
+    "in",
+    "on",
+    "at",
+    "by",
+    "near",
+    "next",
+    "beside",
+    "behind",
+    "between",
+    "with",
+    "without",
+    "into",
+    "onto",
+    "over",
+    "under",
+    "past",
+    "toward",
+    "towards",
+    "around",
+    "across",
+    "along",
+    "for",
+    "up",
+    "down",
+    "off",
+    "out",
+    "through",
+    "via",
+    "than",
+    "apart",
+    "except",
+    "besides",
+    "opposite",
+    "against",
+    "inside",
+    "outside",
+    "beyond",
+    "after",
+    "before",
+    "close",
+    "round",
+    "about",
+    "alongside",
+    "beneath",
+    "below",
+    "above",
+    "facing",
+    "and",
+    "then",
+    "or",
+    "but",
+    "nor",
+    "so",
+    "while",
+    "once",
+    "if",
+    "when",
+    "where",
+    "until",
+    "plus",
+    "also",
+    "too",
+    "again",
+    "please",
+    "pls",
+    "thanks",
+    "thank",
+    "cheers",
+    "ta",
+    "now",
+    "just",
+    "only",
+    "there",
+    "here",
+    "is",
+    "are",
+    "be",
+    "was",
+    "it",
+    "one",
+    "ones",
+    "you",
+    "me",
+    "us",
+    "i",
+    "we",
+    "them",
+    "him",
+    "it's",
+    "that's",
+    "thats",
+    "who",
+    "whose",
+    "counting",
+    "counted",
+    "number",
+];
+
+/// Words after which a name's next word reads as its end: how an object is counted or
+/// placed ("the ball return counting from the west", "the ball return by the bench").
+const AFTER_A_NAME: &[&str] = &[
+    "counting", "counted", "from", "by", "near", "nearest", "closest", "furthest", "farthest",
+    "next", "in", "on", "at", "beside", "behind", "to", "of", "that", "which", "with",
+];
+
+/// Whether `w` is a count, a colour, a size, a direction or a superlative ("third",
+/// "red", "big", "west", "northernmost", "biggest"): a word that says which object, never
+/// what it is.
+fn says_which(w: &str) -> bool {
+    said_count(w).is_some()
+        || matches!(w, "last" | "final" | "middle" | "next" | "penultimate")
+        || is_colour_word(w)
+        || w.chars().next().is_some_and(|c| c.is_ascii_digit())
+        || SIZE_STEMS.iter().any(|s| w.starts_with(s))
+        || names_a_direction(w)
+        || w.ends_with("est")
+        || w.ends_with("most")
+}
+
+/// Whether `w` may be a word of an object's name: none of [`FUNCTION_WORDS`], nor a word
+/// that [`says_which`] object.
+fn may_name(w: &str) -> bool {
+    !FUNCTION_WORDS.contains(&w) && !DETERMINERS.contains(&w) && !says_which(w)
+}
+
+/// The objects of `tuples` (with no map: extraction) that the person named with a word
+/// more, right next to the words listed: a word before them that follows an article, a
+/// count, a colour or another word that [`says_which`] ("the third *waiting* bench",
+/// "the *oak* barrel"), or a word after them that is followed by a word of
+/// [`AFTER_A_NAME`] ("the ball *return* counting from the west"); neither word is any
+/// of [`FUNCTION_WORDS`], says which object, or is a word of some tuple's object. For one-
+/// and two-word objects; a spaced dash ends a phrase as punctuation does.
+///
+/// formats.md's tuple holds "the instruction's own word" for the object; read on
+/// held-out v11 and v12's extraction cases (dev), 11 of 20 misses listed a name less one
+/// of its words ("waiting bench" as `bench`, "ball return" as `ball`), although worked
+/// examples list such names whole. Of the 565 cases of the extraction suites written
+/// before held-out v13 (each `expected` answer read as if the model had written it), none
+/// is found.
+#[must_use]
+pub fn names_cut(instruction: &str, tuples: &[Tuple]) -> Vec<NameCut> {
+    let single = |w: &str| map_core::matcher::singular(w);
+    let mut listed: Vec<String> = Vec::new();
+    for t in tuples {
+        for w in words(&t.object) {
+            listed.push(single(&w));
+            listed.push(w);
+        }
+    }
+    let phrases: Vec<Vec<String>> = instruction
+        .split(" - ")
+        .flat_map(|p| p.split(" \u{2013} "))
+        .flat_map(clauses)
+        .collect();
+    let mut out = Vec::new();
+    for (index, t) in tuples.iter().enumerate() {
+        let name: Vec<String> = words(&t.object).iter().map(|w| single(w)).collect();
+        let n = name.len();
+        if n == 0 || n > 2 {
+            continue;
+        }
+        let found = phrases.iter().find_map(|c| {
+            (0..(c.len() + 1).saturating_sub(n))
+                .find(|&i| {
+                    c[i..i + n]
+                        .iter()
+                        .map(|w| single(w))
+                        .eq(name.iter().cloned())
+                })
+                .map(|i| (c, i))
+        });
+        let Some((c, i)) = found else { continue };
+        let free = |w: &str| {
+            may_name(w) && !listed.contains(&w.to_string()) && !listed.contains(&single(w))
+        };
+        let opens = |w: &str| DETERMINERS.contains(&w) || says_which(w);
+        let before = (i >= 2 && free(&c[i - 1]) && opens(&c[i - 2]))
+            .then(|| format!("{} {}", c[i - 1], name.join(" ")));
+        let after = c
+            .get(i + n + 1)
+            .filter(|next| free(&c[i + n]) && AFTER_A_NAME.contains(&next.as_str()))
+            .map(|_| format!("{} {}", name.join(" "), single(&c[i + n])));
+        if let Some(said) = before.or(after) {
+            out.push(NameCut {
+                said,
+                listed: t.object.clone(),
+                index,
+            });
+        }
+    }
+    out
+}
+
+/// An object the objects line lists with fewer words than the person named it with
+/// ([`names_cut`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NameCut {
+    /// The name with the word more, in the objects line's form ("oak barrel").
+    pub said: String,
+    /// The object as listed ("barrel").
+    pub listed: String,
+    /// Which tuple of the line it is (from 0).
+    pub index: usize,
+}
+
 /// What a clause may say of the objects it names, and only of those.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum SaidOf {
@@ -3612,6 +3891,122 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn a_name_listed_with_fewer_words_than_said_is_found() {
+        let cut = |instruction: &str, line: &str| -> Vec<String> {
+            names_cut(instruction, &crate::tuples::parse_tuples(line).unwrap())
+                .into_iter()
+                .map(|n| format!("{}/{}/{}", n.said, n.listed, n.index))
+                .collect()
+        };
+        // A word before the name, after an article, a count or a superlative.
+        assert_eq!(
+            cut("the third waiting bench", "[(bench, 3, None)]"),
+            ["waiting bench/bench/0"]
+        );
+        assert_eq!(
+            cut(
+                "the last dog kennel counting from the west, then the waiting bench that's green",
+                "[(kennel, last, None), (bench, None, green)]"
+            ),
+            ["dog kennel/kennel/0", "waiting bench/bench/1"]
+        );
+        assert_eq!(
+            cut(
+                "the northernmost treatment trolley",
+                "[(trolley, 1, None, north_to_south)]"
+            ),
+            ["treatment trolley/trolley/0"]
+        );
+        // A word after it, followed by how it is counted or placed (a plural said).
+        assert_eq!(
+            cut(
+                "take me to the fourth ball return from the east",
+                "[(ball, 4, None)]"
+            ),
+            ["ball return/ball/0"]
+        );
+        assert_eq!(
+            cut(
+                "the ball returns counting from the west",
+                "[(ball, None, None)]"
+            ),
+            ["ball return/ball/0"]
+        );
+        // The whole name listed; a colour, a count, a courtesy, a verb or another
+        // object's word beside it; a typo of a count; a spaced dash; no article before.
+        for (instruction, line) in [
+            ("the oak barrel", "[(oak barrel, None, None)]"),
+            ("go to the chair painted red", "[(chair, None, red)]"),
+            (
+                "the westernmost white freezer plz",
+                "[(freezer, 1, white, west_to_east)]",
+            ),
+            (
+                "go to the thrid table from the north",
+                "[(table, 3, None, north_to_south)]",
+            ),
+            (
+                "the big chair near the sofa",
+                "[(chair, None, None), (sofa, None, None)]",
+            ),
+            (
+                "there are a few booth seats - pick the blue one",
+                "[(booth seat, None, blue)]",
+            ),
+            (
+                "the mash tun - stand on its west side",
+                "[(mash tun, None, None)]",
+            ),
+            ("visit oak barrel", "[(barrel, None, None)]"),
+            (
+                "the sofa chair, then the chair",
+                "[(sofa, None, None), (chair, None, None)]",
+            ),
+            (
+                "the crate next to the blue cabinet checked",
+                "[(crate, None, None), (cabinet, None, blue)]",
+            ),
+        ] {
+            assert!(cut(instruction, line).is_empty(), "{instruction}");
+        }
+    }
+
+    /// No `expected` answer of the extraction suites written before held-out v13 reads
+    /// as a name cut short ([`names_cut`]): each is what a right answer lists.
+    #[test]
+    fn no_right_answer_of_the_earlier_extraction_suites_is_a_name_cut_short() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/suites");
+        let mut cases = 0;
+        for v in ["", "2", "3", "4", "7", "8", "9", "10", "11", "12"] {
+            let name = if v.is_empty() {
+                "extract.extract.jsonl".to_string()
+            } else {
+                format!("heldout{v}.extract.jsonl")
+            };
+            let text = std::fs::read_to_string(dir.join(&name)).unwrap();
+            for line in text.lines().filter(|l| !l.trim().is_empty()) {
+                let case: serde_json::Value = serde_json::from_str(line).unwrap();
+                let tuples: Vec<Tuple> = case["expected"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|t| Tuple {
+                        object: t["object"].as_str().unwrap().to_string(),
+                        ordinal: None,
+                        colour: None,
+                        order: None,
+                    })
+                    .collect();
+                let instruction = case["instruction"].as_str().unwrap();
+                let found = names_cut(instruction, &tuples);
+                assert!(found.is_empty(), "{name} {}: {found:?}", case["id"]);
+                cases += 1;
+            }
+        }
+        assert_eq!(cases, 565);
+    }
+
+    #[test]
     fn a_place_said_of_an_object_and_listed_by_no_tuple_is_found() {
         let unlisted = |instruction: &str, line: &str| -> Vec<String> {
             places_unlisted(instruction, &crate::tuples::parse_tuples(line).unwrap())
@@ -3768,11 +4163,20 @@ pub(crate) mod tests {
         let no_return = "objects: [(kitchen, None, None)]\nplan:\nmove_to_object(\"kitchen\");";
         assert_eq!(first("the kitchen and come back here", no_return), None);
         // A colour said of an object the plan never picks: placed as the object the plan
-        // lacks, after the steps for what was named before it (held-out v10, dev, ka05).
+        // lacks, after the steps for what was named before it (held-out v10, dev, ka05):
+        // the sofa, said alone in its clause, after the chair and the kitchen; said with
+        // the kitchen, in place of the kitchen's step.
         let no_sofa = "objects: [(chair, None, None), (kitchen, None, None), (sofa, None, black), (table, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(\"kitchen\");\nmove_to_object(get_obj(\"table\"));";
         assert_eq!(
             first(
                 "the chair, then the kitchen, then the black sofa, then the table",
+                no_sofa
+            ),
+            Some(2)
+        );
+        assert_eq!(
+            first(
+                "the chair, then in the kitchen the black sofa, then the table",
                 no_sofa
             ),
             Some(1)
@@ -3796,12 +4200,28 @@ pub(crate) mod tests {
             Some(0)
         );
         // An object the plan lacks: the steps for what was named before it stand, in the
-        // order named, less the last (the kitchen named after the table and the chair:
-        // the table stands; the chair may be where the kitchen was meant to go).
+        // order named, less the last where the missing one is said with it (the kitchen
+        // of "the chair in the kitchen": the table stands; the chair may be where the
+        // kitchen was meant to go) ...
         let no_kitchen = "objects: [(table, None, None), (chair, None, None), (kitchen, None, None)]\nplan:\nmove_to_object(get_obj(\"table\"));\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"sofa\"));";
         assert_eq!(
-            first("the table, then the chair, then the kitchen", no_kitchen),
+            first("the table, then the chair in the kitchen", no_kitchen),
             Some(1)
+        );
+        // ... and all of them where its clause names it alone (held-out v12, dev, ma02:
+        // "..., then a ball rack other than the green one, and call it a day in the pro
+        // shop" kept the booth seat and the claw machine, and the re-ask wrote the ball
+        // rack again and no pro shop, three times).
+        assert_eq!(
+            first("the table, then the chair, then the kitchen", no_kitchen),
+            Some(2)
+        );
+        assert_eq!(
+            first(
+                "the table, then the chair, and stop in the kitchen",
+                no_kitchen
+            ),
+            Some(2)
         );
         // Named out of the plan's order: nothing stands.
         assert_eq!(
@@ -3815,14 +4235,15 @@ pub(crate) mod tests {
             Some(0)
         );
         // A synonym and a room picked with `region:` are named as said ("the telly",
-        // "the table in the kitchen").
+        // "the table in the kitchen"): all three stand, and the bed, said alone, goes
+        // after them.
         let tv = "objects: [(telly, None, None), (table, None, None), (chair, None, None), (bed, None, None)]\nplan:\nmove_to_object(get_obj(\"tv\"));\nmove_to_object(get_obj(\"table\", #{region: \"kitchen\"}));\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"sofa\"));";
         assert_eq!(
             first(
                 "the telly, the table in the kitchen, the chair, then the bed",
                 tv
             ),
-            Some(2)
+            Some(3)
         );
         // A finding about one pick is at its step, not at an earlier pick of its label:
         // an unsaid colour on the second chair keeps the first chair and the sofa.

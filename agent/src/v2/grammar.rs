@@ -119,11 +119,13 @@ pub struct Vocabulary {
     /// word that begins with a colour word, "tan", was barred) and "hop sack" into
     /// `hopsack`.
     pub object_words: Option<Vec<String>>,
-    /// A word of [`Vocabulary::object_words`] that some object of the objects line must
-    /// begin with: an extraction's re-ask after a place the person said that the first answer
-    /// listed no word of (`check::places_unlisted`; measured on held-out v11, dev, the
-    /// re-ask that only named the words got the same answer in 4 of 5 cases). Unset, or
-    /// not one of those words: no such hold, and the grammar is the same as without it.
+    /// One to three words of [`Vocabulary::object_words`], separated by spaces, that some
+    /// object of the objects line must begin with: an extraction's re-ask after a place
+    /// the person said that the first answer listed no word of (`check::places_unlisted`;
+    /// measured on held-out v11, dev, the re-ask that only named the words got the same
+    /// answer in 4 of 5 cases), or after a name listed with fewer words than said
+    /// (`check::names_cut`: the whole name). Unset, or not made of those words: no such
+    /// hold, and the grammar is the same as without it.
     pub object_word_required: Option<String>,
     /// With [`Vocabulary::object_word_required`]: exactly this many tuples come before the
     /// one that begins with that word (where the place was said, in the order of mention;
@@ -534,10 +536,14 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
     // that repeats a tuple stops (SmolLM2 listed `(desk, 1, None)` to the token limit).
     // With a word required of some object (`object_word_required`), one tuple
     // (`rtuple`) has it.
-    let required = vocab
-        .object_word_required
-        .as_ref()
-        .filter(|r| vocab.object_words.as_ref().is_some_and(|o| o.contains(r)));
+    let required = vocab.object_word_required.as_ref().filter(|r| {
+        let n = r.split(' ').count();
+        (1..=3).contains(&n)
+            && vocab
+                .object_words
+                .as_ref()
+                .is_some_and(|o| r.split(' ').all(|w| o.iter().any(|x| x == w)))
+    });
     if required.is_some() {
         // (A repetition `{0}` is not written: llguidance did not read it as none.)
         let before = match vocab.object_word_after.min(15) {
@@ -631,10 +637,13 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
     }
     w.rule("tuple", &alternatives.join(" | "));
     if let Some(r) = required {
-        w.rule(
-            "rword",
-            &format!("{} (\" \" oword){{0,2}}", alt(&[r], false)),
-        );
+        let more = 3 - r.split(' ').count();
+        let rest = if more == 0 {
+            String::new()
+        } else {
+            format!(" (\" \" oword){{0,{more}}}")
+        };
+        w.rule("rword", &format!("{}{rest}", alt(&[r], false)));
         let rtuple = tuple("rword", free);
         w.rule("rtuple", &rtuple);
     }

@@ -101,17 +101,22 @@ pub fn extract(
         source,
         answer: c.text.clone(),
     })?;
-    // A place the person put an object in that no tuple lists: one re-ask naming the
-    // words (as a plan's re-ask is made); its answer stands where it reads.
+    // A place the person put an object in that no tuple lists, or an object listed with
+    // fewer words than the person named it with: one re-ask naming the words (as a
+    // plan's re-ask is made); its answer stands where it reads.
     let unlisted = check::places_unlisted(instruction, &tuples);
-    if options.extraction_reask && !unlisted.is_empty() {
-        tracing::debug!(answer = %c.text, ?unlisted, "objects line lacks a place; re-asking once");
-        // The first such place's word is required of some object on the re-ask's line.
-        if let Some(mut vocab) = vocab {
-            if let Some(p) = unlisted.first() {
-                vocab.object_word_required = Some(p.word.clone());
-                vocab.object_word_after = p.after;
-            }
+    let cut = check::names_cut(instruction, &tuples);
+    if options.extraction_reask && !(unlisted.is_empty() && cut.is_empty()) {
+        tracing::debug!(answer = %c.text, ?unlisted, ?cut, "objects line lacks a place or a word of a name; re-asking once");
+        // The words of the first of them, in the order of the line, are required of the
+        // object that begins there (the place's first word; the whole name).
+        let holds = unlisted
+            .iter()
+            .map(|p| (p.after, p.word.clone()))
+            .chain(cut.iter().map(|n| (n.index, n.said.clone())));
+        if let (Some(mut vocab), Some((after, words))) = (vocab, holds.min_by_key(|(a, _)| *a)) {
+            vocab.object_word_required = Some(words);
+            vocab.object_word_after = after;
             req.grammar = Some(objects_grammar(&vocab));
             req.lark = options.llguidance.then(|| objects_lark(&vocab));
         }
@@ -121,6 +126,10 @@ pub fn extract(
                 let p = &u.phrase;
                 format!("the person said \"{p}\", but the objects line lists no such place: if it names a room or a place, list it too, in the order said")
             })
+            .chain(cut.iter().map(|n| {
+                let (said, listed) = (&n.said, &n.listed);
+                format!("the person said \"{said}\", but the objects line lists ({listed}, ...): list an object by all the words of its name, ({said}, ...)")
+            }))
             .collect();
         add_reask(prompts, &mut req.messages, &notes)?;
         let again = backend.complete(&req)?;
@@ -1568,6 +1577,35 @@ mod tests {
         assert_eq!(
             objects_lark(&v),
             objects_lark(&extract_vocabulary(kit, &options))
+        );
+        // A whole name required (a re-ask after a name listed less a word): the object
+        // begins with both words, and may take one more.
+        let oak = "the oak barrels by the blue keg";
+        let mut v = extract_vocabulary(oak, &options);
+        v.object_word_required = Some("oak barrel".into());
+        let lark = objects_lark(&v);
+        let line = |l: &str| grammar::tests::lark_accepts(&lark, &format!("objects: [{l}]\n"));
+        assert!(line("(oak barrel, None, None), (keg, None, blue)").is_ok());
+        assert!(line("(oak barrel keg, None, None)").is_ok());
+        assert!(line("(barrel, None, None), (keg, None, blue)").is_err());
+        assert!(line("(oak, None, None), (keg, None, blue)").is_err());
+        // Three words required: no word more.
+        v.object_word_required = Some("oak barrel keg".into());
+        let lark3 = objects_lark(&v);
+        assert!(
+            grammar::tests::lark_accepts(&lark3, "objects: [(oak barrel keg, None, None)]\n")
+                .is_ok()
+        );
+        assert!(grammar::tests::lark_accepts(
+            &lark3,
+            "objects: [(oak barrel keg blue, None, None)]\n"
+        )
+        .is_err());
+        // A word the person did not say: no hold.
+        v.object_word_required = Some("oak cask".into());
+        assert_eq!(
+            objects_lark(&v),
+            objects_lark(&extract_vocabulary(oak, &options))
         );
         // GBNF is built from the same words.
         let gbnf = objects_grammar(&extract_vocabulary(tank, &options));
