@@ -227,6 +227,34 @@ pub fn disputed_steps(
     plan: &TypedPlan,
     pose: Pose,
 ) -> Option<Vec<usize>> {
+    Some(
+        disputed_places(map, instruction, findings, plan, pose)?
+            .into_iter()
+            .map(|p| p.at)
+            .collect(),
+    )
+}
+
+/// Where in a plan a finding is ([`disputed_places`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Place {
+    /// The step it is about, or the step before which the one the plan lacks goes (the
+    /// plan's length: after its last).
+    pub at: usize,
+    /// Whether it is about something the plan lacks ([`About::Missing`], or the picks of
+    /// a label no step picks): a step goes in before `at`, and the step at `at` stands.
+    pub lacking: bool,
+}
+
+/// [`disputed_steps`], each place with whether the plan lacks what it is about.
+#[must_use]
+pub fn disputed_places(
+    map: &IvlMap,
+    instruction: &str,
+    findings: &[Finding],
+    plan: &TypedPlan,
+    pose: Pose,
+) -> Option<Vec<Place>> {
     let labels = |s: &Step| step_labels(map, s, pose);
     let mentions: Vec<String> = name_mentions(map, &words(instruction), pose)
         .into_iter()
@@ -286,17 +314,17 @@ pub fn disputed_steps(
             | (FindingKind::Parts, About::Missing(_)) => {}
             _ => return None,
         }
-        let at = match about {
-            About::Step(i) => (*i < plan.steps.len()).then_some(*i)?,
+        let place = |at: usize, lacking: bool| Place { at, lacking };
+        out.push(match about {
+            About::Step(i) => place((*i < plan.steps.len()).then_some(*i)?, false),
             About::Label(l) => match plan.steps.iter().position(|s| labels(s).contains(l)) {
-                Some(i) => i,
+                Some(i) => place(i, false),
                 // About the picks of a label the plan has none of ("the blue hospital
                 // bed" said, no hospital bed picked): placed as what the plan lacks.
-                None => missing(l)?,
+                None => place(missing(l)?, true),
             },
-            About::Missing(l) => missing(l)?,
-        };
-        out.push(at);
+            About::Missing(l) => place(missing(l)?, true),
+        });
     }
     Some(out)
 }

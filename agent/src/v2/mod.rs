@@ -127,8 +127,9 @@ pub fn extract(
                 format!("the person said \"{p}\", but the objects line lists no such place: if it names a room or a place, list it too, in the order said")
             })
             .chain(cut.iter().map(|n| {
-                let (said, listed) = (&n.said, &n.listed);
-                format!("the person said \"{said}\", but the objects line lists ({listed}, ...): list an object by all the words of its name, ({said}, ...)")
+                let said = &n.said;
+                let listed = tuples.get(n.index).map_or_else(String::new, Tuple::paper_form);
+                format!("the person said \"{said}\", but the objects line lists {listed}: list each object by all the words of its name as the person said it, here \"{said}\"")
             }))
             .collect();
         add_reask(prompts, &mut req.messages, &notes)?;
@@ -1106,17 +1107,18 @@ fn held_prefix(
     ctx: &PlanContext<'_>,
 ) -> Option<Held> {
     let answer = parse_answer(text).ok()?;
-    let places = check::disputed_steps(ctx.map, instruction, findings, &answer.plan, ctx.pose())?;
-    let disputed = places.iter().copied().min()?;
-    // The steps from the first disputed place on that no finding is about, and one for
-    // that place: the step it mends, or the one it lacks; none where a finding there
-    // bars a stop the plan made at an anchor (that stop goes).
+    let places = check::disputed_places(ctx.map, instruction, findings, &answer.plan, ctx.pose())?;
+    let disputed = places.iter().map(|p| p.at).min()?;
+    // The steps from the first disputed place on that no finding is about (a step before
+    // which a lacking one goes is not), and one for that place: the step it mends, or
+    // the one it lacks; none where a finding there bars a stop the plan made at an
+    // anchor (that stop goes).
     let goes = findings
         .iter()
         .zip(&places)
-        .any(|(f, p)| *p == disputed && matches!(f.bar, Some(check::Bar::AnchorStop { .. })));
+        .any(|(f, p)| p.at == disputed && matches!(f.bar, Some(check::Bar::AnchorStop { .. })));
     let later = (disputed..answer.plan.steps.len())
-        .filter(|i| !places.contains(i))
+        .filter(|i| !places.iter().any(|p| p.at == *i && !p.lacking))
         .count()
         + usize::from(!goes);
     let steps = answer
