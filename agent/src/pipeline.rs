@@ -157,8 +157,10 @@ pub struct PlanOptions {
     /// Off: any word (the default before stop 75; for comparison).
     pub said_object_words: bool,
     /// With no map (extraction): where the person puts an object in a place ("the till in
-    /// the snack bar") that no tuple of the answer lists (`check::places_unlisted`), one
-    /// re-ask naming the words. Default on (`--no-extraction-reask` turns it off).
+    /// the snack bar") that no tuple of the answer lists (`check::places_unlisted`), or
+    /// where a tuple lists a name less a word the person said ("the third waiting bench"
+    /// as `bench`, `check::names_cut`), one re-ask naming the words. Default on
+    /// (`--no-extraction-reask` turns it off).
     pub extraction_reask: bool,
     /// With `reask_holds_agreed`: the re-ask's answer, continued after the steps it keeps,
     /// writes at least as many steps as the first answer made from its first disputed
