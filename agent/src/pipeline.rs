@@ -162,6 +162,11 @@ pub struct PlanOptions {
     /// as `bench`, `check::names_cut`), one re-ask naming the words. Default on
     /// (`--no-extraction-reask` turns it off).
     pub extraction_reask: bool,
+    /// A re-ask that keeps the steps before a stop the plan lacks, said alone in its
+    /// clause ("then the black radar screen"), has the continuation begin with a stop
+    /// there (`check::Place::stop`, `grammar::FirstSide::any_stop`). Default on
+    /// (`--reask-stop-anywhere` turns it off).
+    pub reask_stops_first: bool,
     /// With `reask_holds_agreed`: the re-ask's answer, continued after the steps it keeps,
     /// writes at least as many steps as the first answer made from its first disputed
     /// place on that no finding is about, and one for that place (`v2::Held::later`).
@@ -254,6 +259,7 @@ impl Default for PlanOptions {
             orders_of_said: true,
             said_object_words: true,
             extraction_reask: true,
+            reask_stops_first: true,
             reask_keeps_steps: true,
             anchors_of_said: true,
             colours_of_others: true,

@@ -229,8 +229,29 @@ fn a_reask_writes_at_least_the_steps_no_finding_disputes() {
         "{}",
         kept.content
     );
+    // The continuation begins with a stop in the bedroom, and writes one step more.
+    let lark = reqs[1].lark.as_deref().unwrap();
+    assert!(
+        lark.contains("firstside") && lark.contains("\"\\\"bedroom\\\"\""),
+        "{lark}"
+    );
     let g = reqs[1].grammar.as_deref().unwrap();
-    assert!(g.contains("stmtn (\"\\n\" stmtn){1,15}"), "{g}");
+    assert!(g.contains("root ::= firstside \"\\n\" ("), "{g}");
+    // `--reask-stop-anywhere`: no such hold, and the floor of two.
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let b = Scripted::new(&[
+        &lacking,
+        "move_to_object(\"bedroom\");\nmove_to_object(\"office\");",
+    ]);
+    let mut ctx = v2(&map, &robot);
+    ctx.options.reask_stops_first = false;
+    plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
+    let g = b.requests()[1].grammar.clone().unwrap();
+    assert!(
+        !g.contains("firstside") && g.contains("stmtn (\"\\n\" stmtn){1,15}"),
+        "{g}"
+    );
     // `--reask-may-shorten`: no floor.
     let map = flat_a();
     let robot = SimRobot::new(map.clone());

@@ -350,6 +350,10 @@ pub(crate) struct ModelArgs {
     /// less a word the person said (the default before stop 75; for comparison).
     #[arg(long)]
     pub(crate) no_extraction_reask: bool,
+    /// Let a re-ask that keeps the steps before a stop the plan lacks write that stop
+    /// anywhere after them, not first (the default before stop 76; for comparison).
+    #[arg(long)]
+    pub(crate) reask_stop_anywhere: bool,
     /// Let an object on the objects line of an extraction case be made of any word, not
     /// only the person's words and their singulars (the default before stop 75; for
     /// comparison).
@@ -438,6 +442,7 @@ impl ModelArgs {
             orders_of_said: !self.any_direction,
             said_object_words: !self.any_object_words,
             extraction_reask: !self.no_extraction_reask,
+            reask_stops_first: !self.reask_stop_anywhere,
             reask_keeps_steps: !self.reask_may_shorten,
             anchors_of_said: !self.anchors_anywhere,
             colours_of_others: !self.colours_of_others_allowed,

@@ -236,7 +236,7 @@ pub fn disputed_steps(
 }
 
 /// Where in a plan a finding is ([`disputed_places`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Place {
     /// The step it is about, or the step before which the one the plan lacks goes (the
     /// plan's length: after its last).
@@ -244,6 +244,9 @@ pub struct Place {
     /// Whether it is about something the plan lacks ([`About::Missing`], or the picks of
     /// a label no step picks): a step goes in before `at`, and the step at `at` stands.
     pub lacking: bool,
+    /// Where what the plan lacks is the only thing its clause names ("then the black
+    /// radar screen"): its label, a stop of its own at `at`.
+    pub stop: Option<String>,
 }
 
 /// [`disputed_steps`], each place with whether the plan lacks what it is about.
@@ -314,16 +317,32 @@ pub fn disputed_places(
             | (FindingKind::Parts, About::Missing(_)) => {}
             _ => return None,
         }
-        let place = |at: usize, lacking: bool| Place { at, lacking };
+        let mended = |at: usize| Place {
+            at,
+            lacking: false,
+            stop: None,
+        };
+        let lacking = |l: &str| -> Option<Place> {
+            let stop = mentions
+                .iter()
+                .position(|m| m == l)
+                .filter(|&k| alone(k))
+                .map(|_| l.to_string());
+            Some(Place {
+                at: missing(l)?,
+                lacking: true,
+                stop,
+            })
+        };
         out.push(match about {
-            About::Step(i) => place((*i < plan.steps.len()).then_some(*i)?, false),
+            About::Step(i) => mended((*i < plan.steps.len()).then_some(*i)?),
             About::Label(l) => match plan.steps.iter().position(|s| labels(s).contains(l)) {
-                Some(i) => place(i, false),
+                Some(i) => mended(i),
                 // About the picks of a label the plan has none of ("the blue hospital
                 // bed" said, no hospital bed picked): placed as what the plan lacks.
-                None => place(missing(l)?, true),
+                None => lacking(l)?,
             },
-            About::Missing(l) => place(missing(l)?, true),
+            About::Missing(l) => lacking(l)?,
         });
     }
     Some(out)

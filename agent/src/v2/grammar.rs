@@ -187,6 +187,29 @@ pub struct FirstSide {
     /// The names its object may be picked by (a label's names); those the vocabulary
     /// does not offer, or bars from stops ([`Vocabulary::no_stops`]), are left out.
     pub names: Vec<String>,
+    /// Any stop at an object of those names, or in a room of them, instead of the one
+    /// side move: a plain stop or a move to a side of it (`function` is then
+    /// `move_to_object`). A re-ask's continuation after
+    /// the steps it keeps, where the first disputed place is a stop the plan lacks
+    /// ([`super::check::Place::stop`]).
+    pub any_stop: bool,
+}
+
+/// The step functions a stop at one object is made with ([`FirstSide::any_stop`]): the
+/// plain stop and the moves to a side of it.
+fn stop_functions() -> Vec<&'static str> {
+    use planner_dsl::typed::Side;
+    let sides = [
+        Side::Left,
+        Side::Right,
+        Side::North,
+        Side::South,
+        Side::East,
+        Side::West,
+    ];
+    std::iter::once(GOTO_FUNCTION)
+        .chain(sides.into_iter().map(Side::function))
+        .collect()
 }
 
 /// The step function of a plain stop at an object ([`Step::GoTo`](planner_dsl::typed::Step::GoTo)),
@@ -1552,6 +1575,24 @@ fn first_side(vocab: &Vocabulary) -> Option<(String, Vec<String>)> {
     if !STEP_FUNCTIONS.contains(&f.function.as_str()) {
         return None;
     }
+    if f.any_stop {
+        // Any stop at a pick or a bare name of its names (a room's too).
+        let names: Vec<String> = f
+            .names
+            .iter()
+            .filter(|n| {
+                (vocab.names.contains(n) && !vocab.no_stops.contains(n))
+                    || vocab.regions.contains(n)
+            })
+            .cloned()
+            .collect();
+        let calls: Vec<String> = stop_functions()
+            .into_iter()
+            .filter_map(|n| call_rule_with(n, "fobj", None))
+            .collect();
+        return (!names.is_empty() && !calls.is_empty())
+            .then(|| (format!("({})", calls.join(" | ")), names));
+    }
     let pair = f.function == PAIR_FUNCTION;
     // A side move takes an object (`fobj`), never a name with a selection, so whether
     // pairs are offered does not matter to it; a pair takes X's names and their pair
@@ -1618,7 +1659,13 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     // A floor on the statements (`min_steps`) holds the first alternative of each, the
     // plan without a `let`: at least that many before the end, or before the move back
     // (which ends a plan that comes back).
-    let more = vocab.min_steps.clamp(1, 16) - 1;
+    // With a first step held (`first_side`), the floor counts it.
+    let floor = if first_side(vocab).is_some() {
+        vocab.min_steps.saturating_sub(1)
+    } else {
+        vocab.min_steps
+    };
+    let more = floor.clamp(1, 16) - 1;
     let stmts = if vocab.return_required {
         format!(
             concat!(
@@ -1634,11 +1681,14 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         )
     };
     // A first step the plan must make (`first_side`): that step, then the statements
-    // as above (at least one where a move back is required), or nothing more.
+    // as above (at least one where a move back is required, or where the floor on the
+    // statements counts more than that step; the floor then counts the rest), or
+    // nothing more.
     let first = first_side(vocab);
     let stmts = match (&first, vocab.return_required) {
         (None, _) => stmts.clone(),
         (Some(_), true) => format!("firstside \"\\n\" ({stmts})"),
+        (Some(_), false) if vocab.min_steps >= 2 => format!("firstside \"\\n\" ({stmts})"),
         (Some(_), false) => format!("firstside (\"\\n\" ({stmts}))?"),
     };
     match part {
@@ -1807,9 +1857,12 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 _ => "fpname (\", \" selmap)?".to_string(),
             };
             w.rule("fnamesel", &namesel);
-        } else {
+        } else if names.iter().any(|n| vocab.names.contains(n)) {
             w.rule("fpick", &picks_but(groups.as_deref(), &get, &others, "f"));
             w.rule("fobj", "fpick | fpname");
+        } else {
+            // Rooms alone: the bare name.
+            w.rule("fobj", "fpname");
         }
         w.rule("firstside", &format!("{comment}{call} \";\""));
     }
@@ -2715,6 +2768,7 @@ pub(crate) mod tests {
             }
             let before = answer_lark(&v);
             v.first_side = Some(FirstSide {
+                any_stop: false,
                 function: "move_north".into(),
                 names: vec!["sofa".into(), "couch".into()],
             });
@@ -2757,6 +2811,63 @@ pub(crate) mod tests {
             v.first_side = None;
             assert_eq!(barred_only, answer_lark(&v));
         }
+    }
+
+    #[test]
+    fn a_stop_held_first_is_any_stop_at_its_names() {
+        let mut v = vocab();
+        // An object: a plain stop or a move to a side of it, picked or named.
+        v.first_side = Some(FirstSide {
+            function: GOTO_FUNCTION.into(),
+            names: vec!["sofa".into(), "couch".into()],
+            any_stop: true,
+        });
+        let lark = plan_lark(&v);
+        for ok in [
+            "move_to_object(get_obj(\"couch\", #{colour: \"red\"}));\nmove_to_object(\"kitchen\");",
+            "move_north(get_obj(\"sofa\"));",
+            "move_to_left(\"sofa\");",
+        ] {
+            assert!(lark_accepts(&lark, ok).is_ok(), "{ok}");
+        }
+        for barred in [
+            "move_to_object(get_obj(\"chair\"));\nmove_to_object(get_obj(\"sofa\"));",
+            "move_to_object(\"kitchen\");",
+            "face(get_obj(\"sofa\"));",
+            "move_in_between(get_obj(\"sofa\"), get_obj(\"chair\"));",
+            "let s = get_obj(\"sofa\");\nmove_to_object(s);",
+        ] {
+            assert!(lark_accepts(&lark, barred).is_err(), "{barred}");
+        }
+        assert!(undefined_rules(&plan_grammar(&v)).is_empty());
+        // A room: its bare name.
+        v.first_side = Some(FirstSide {
+            function: GOTO_FUNCTION.into(),
+            names: vec!["kitchen".into()],
+            any_stop: true,
+        });
+        let lark = plan_lark(&v);
+        assert!(lark_accepts(&lark, "move_to_object(\"kitchen\");").is_ok());
+        assert!(lark_accepts(&lark, "move_to_object(get_obj(\"sofa\"));").is_err());
+        assert!(undefined_rules(&plan_grammar(&v)).is_empty());
+        // A floor counts the held stop: with two, one more statement is required.
+        v.min_steps = 2;
+        let lark = plan_lark(&v);
+        assert!(lark_accepts(&lark, "move_to_object(\"kitchen\");").is_err());
+        assert!(lark_accepts(
+            &lark,
+            "move_to_object(\"kitchen\");\nmove_to_object(\"chair\");"
+        )
+        .is_ok());
+        // No name of it on offer: nothing is held.
+        v.first_side = Some(FirstSide {
+            function: GOTO_FUNCTION.into(),
+            names: vec!["garage".into()],
+            any_stop: true,
+        });
+        let held = plan_lark(&v);
+        v.first_side = None;
+        assert_eq!(held, plan_lark(&v));
     }
 
     #[test]

@@ -648,6 +648,7 @@ fn hold_first_side(v: &mut Vocabulary, map: &map_core::IvlMap, instruction: &str
     v.first_side = Some(grammar::FirstSide {
         function: function.to_string(),
         names: names_of_labels(v, map, &[label], pose),
+        any_stop: false,
     });
 }
 
@@ -1061,6 +1062,7 @@ pub fn plan_instruction(
                     if let Some(h) = &held {
                         tracing::debug!(
                             steps = h.steps,
+                            first_stop = ?h.first_stop,
                             "the re-ask keeps the steps before the first disputed one"
                         );
                     }
@@ -1088,6 +1090,9 @@ struct Held {
     steps: usize,
     /// Whether a kept step moves back to the start.
     returns: bool,
+    /// What the plan lacks at the first disputed place, where it is a stop of its own
+    /// ([`check::Place::stop`]): the continuation's first step stops there.
+    first_stop: Option<String>,
     /// How many steps the continuation writes at least ([`Vocabulary::min_steps`], with
     /// [`crate::PlanOptions::reask_keeps_steps`]): the answer's steps from the first
     /// disputed place on that no finding is about, and one for that place.
@@ -1159,11 +1164,16 @@ fn held_prefix(
         }
     }
     let returns = check::steps_return(&answer.plan.steps[..steps]);
+    let first_stop = places
+        .iter()
+        .filter(|p| p.at == steps)
+        .find_map(|p| p.stop.clone());
     Some(Held {
         prefix,
         tuples: answer.tuples,
         steps,
         returns,
+        first_stop,
         later,
     })
 }
@@ -1189,10 +1199,22 @@ fn held_answer(
     if held.returns {
         v.return_required = false;
     }
-    // The kept steps hold the first one.
+    // The kept steps hold the first one; the continuation's first step is the stop the
+    // plan lacks there, where it is a stop of its own.
     v.first_side = None;
     if ctx.options.reask_keeps_steps {
         v.min_steps = held.later;
+    }
+    if let (Some(label), true) = (&held.first_stop, ctx.options.reask_stops_first) {
+        let mut names = names_of_labels(&v, ctx.map, std::slice::from_ref(label), ctx.pose());
+        if v.regions.contains(label) {
+            names.push(label.clone());
+        }
+        v.first_side = Some(grammar::FirstSide {
+            function: "move_to_object".into(),
+            names,
+            any_stop: true,
+        });
     }
     continue_plan(backend, req, held.prefix.clone(), &v, ctx, timing)
 }
