@@ -199,16 +199,10 @@ pub struct FirstSide {
 /// plain stop and the moves to a side of it.
 fn stop_functions() -> Vec<&'static str> {
     use planner_dsl::typed::Side;
-    let sides = [
-        Side::Left,
-        Side::Right,
-        Side::North,
-        Side::South,
-        Side::East,
-        Side::West,
-    ];
-    std::iter::once(GOTO_FUNCTION)
-        .chain(sides.into_iter().map(Side::function))
+    STEP_FUNCTIONS
+        .iter()
+        .copied()
+        .filter(|n| *n == GOTO_FUNCTION || Side::from_function(n).is_some_and(Side::is_move))
         .collect()
 }
 
