@@ -245,7 +245,8 @@ pub struct Place {
     /// a label no step picks): a step goes in before `at`, and the step at `at` stands.
     pub lacking: bool,
     /// Where what the plan lacks is the only thing its clause names ("then the black
-    /// radar screen"): its label, a stop of its own at `at`.
+    /// radar screen") and every step before `at` stands for what was named before it:
+    /// its label, a stop of its own at `at`.
     pub stop: Option<String>,
 }
 
@@ -291,7 +292,9 @@ pub fn disputed_places(
         false
     };
     // Where the plan lacks `l`: after the steps for what was named before it.
-    let missing = |l: &str| -> Option<usize> {
+    // With whether every step before that place stands for what was named before it
+    // (a stop said alone there is the next one to make).
+    let missing = |l: &str| -> Option<(usize, bool)> {
         let named_at = mentions.iter().position(|m| m == l)?;
         let mut m = 0;
         let mut agreed: usize = 0;
@@ -303,10 +306,11 @@ pub fn disputed_places(
             m += ls.len();
             agreed += 1;
         }
-        Some(if m == named_at && !alone(named_at) {
-            agreed.saturating_sub(1)
+        let next = m == named_at && alone(named_at);
+        Some(if m == named_at && !next {
+            (agreed.saturating_sub(1), false)
         } else {
-            agreed
+            (agreed, next)
         })
     };
     let mut out = Vec::new();
@@ -323,15 +327,11 @@ pub fn disputed_places(
             stop: None,
         };
         let lacking = |l: &str| -> Option<Place> {
-            let stop = mentions
-                .iter()
-                .position(|m| m == l)
-                .filter(|&k| alone(k))
-                .map(|_| l.to_string());
+            let (at, next) = missing(l)?;
             Some(Place {
-                at: missing(l)?,
+                at,
                 lacking: true,
-                stop,
+                stop: next.then(|| l.to_string()),
             })
         };
         out.push(match about {
@@ -4274,6 +4274,30 @@ pub(crate) mod tests {
         assert_eq!(
             first("the chair, then the table, then the kitchen", no_kitchen),
             Some(0)
+        );
+        // A stop of its own where the steps before it stand for what was named before
+        // it, and only there (held-out v12, dev, mb02: "..., and end the run in the
+        // bottling room" is no next stop after a plan that went astray at its second).
+        let stop = |instruction: &str| {
+            let a = parse_answer(no_kitchen).unwrap();
+            let f = check_answer(&m, instruction, &a.tuples, &a.plan, m.start_pose, &[], &[]);
+            disputed_places(&m, instruction, &f, &a.plan, m.start_pose)
+                .unwrap()
+                .into_iter()
+                .find(|p| p.lacking)
+                .map(|p| (p.at, p.stop))
+        };
+        assert_eq!(
+            stop("the table, then the chair, then the kitchen"),
+            Some((2, Some("kitchen".to_string())))
+        );
+        assert_eq!(
+            stop("the table, then the chair in the kitchen"),
+            Some((1, None))
+        );
+        assert_eq!(
+            stop("the chair, then the table, then the kitchen"),
+            Some((0, None))
         );
         // A missing anchor said with the first stop: nothing stands.
         let no_anchor = "objects: [(chair, None, None), (kitchen, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\"));\nmove_to_object(\"kitchen\");";
