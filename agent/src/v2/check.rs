@@ -274,23 +274,18 @@ pub fn disputed_places(
                 .collect()
         })
         .collect();
-    let by_clause = (per_clause.concat() == mentions).then_some(per_clause);
-    // Whether the `k`th label named is the only one its clause names ("then into
+    // For each label named, whether it is the only one its clause names ("then into
     // triage", "and call it a day in the pro shop"): a place of its own, not one of the
-    // object before it.
-    let alone = |k: usize| -> bool {
-        let Some(by_clause) = &by_clause else {
-            return false;
-        };
-        let mut seen = 0;
-        for c in by_clause {
-            if k < seen + c.len() {
-                return c.len() == 1;
-            }
-            seen += c.len();
-        }
-        false
+    // object before it. None alone where the clauses do not name the labels in order.
+    let alone_at: Vec<bool> = if per_clause.concat() == mentions {
+        per_clause
+            .iter()
+            .flat_map(|c| std::iter::repeat_n(c.len() == 1, c.len()))
+            .collect()
+    } else {
+        Vec::new()
     };
+    let alone = |k: usize| alone_at.get(k).copied().unwrap_or(false);
     // Where the plan lacks `l`: after the steps for what was named before it.
     // With whether every step before that place stands for what was named before it
     // (a stop said alone there is the next one to make).
@@ -313,6 +308,19 @@ pub fn disputed_places(
             (agreed, next)
         })
     };
+    let mended = |at: usize| Place {
+        at,
+        lacking: false,
+        stop: None,
+    };
+    let lacking = |l: &str| -> Option<Place> {
+        let (at, next) = missing(l)?;
+        Some(Place {
+            at,
+            lacking: true,
+            stop: next.then(|| l.to_string()),
+        })
+    };
     let mut out = Vec::new();
     for f in findings {
         let about = f.about.as_ref()?;
@@ -321,19 +329,6 @@ pub fn disputed_places(
             | (FindingKind::Parts, About::Missing(_)) => {}
             _ => return None,
         }
-        let mended = |at: usize| Place {
-            at,
-            lacking: false,
-            stop: None,
-        };
-        let lacking = |l: &str| -> Option<Place> {
-            let (at, next) = missing(l)?;
-            Some(Place {
-                at,
-                lacking: true,
-                stop: next.then(|| l.to_string()),
-            })
-        };
         out.push(match about {
             About::Step(i) => mended((*i < plan.steps.len()).then_some(*i)?),
             About::Label(l) => match plan.steps.iter().position(|s| labels(s).contains(l)) {
@@ -2405,13 +2400,7 @@ const IN_A_PLACE: &[&str] = &["in", "on", "inside"];
 /// in the Y" in 7 of 8 such cases, although worked examples list it.
 #[must_use]
 pub fn places_unlisted(instruction: &str, tuples: &[Tuple]) -> Vec<PlaceUnlisted> {
-    let mut listed: Vec<String> = Vec::new();
-    for t in tuples {
-        for w in words(&t.object) {
-            listed.push(map_core::matcher::singular(&w));
-            listed.push(w);
-        }
-    }
+    let listed = listed_words(tuples);
     let firsts: Vec<String> = tuples
         .iter()
         .filter_map(|t| words(&t.object).into_iter().next())
@@ -2448,6 +2437,19 @@ pub fn places_unlisted(instruction: &str, tuples: &[Tuple]) -> Vec<PlaceUnlisted
         before.extend(c);
     }
     out
+}
+
+/// The words of the objects of `tuples`, each as listed and in the singular: what
+/// [`places_unlisted`] and [`names_cut`] take as listed.
+fn listed_words(tuples: &[Tuple]) -> Vec<String> {
+    let mut listed = Vec::new();
+    for t in tuples {
+        for w in words(&t.object) {
+            listed.push(map_core::matcher::singular(&w));
+            listed.push(w);
+        }
+    }
+    listed
 }
 
 /// A place the objects line lists no word of ([`places_unlisted`]).
@@ -2649,13 +2651,7 @@ fn may_name(w: &str) -> bool {
 #[must_use]
 pub fn names_cut(instruction: &str, tuples: &[Tuple]) -> Vec<NameCut> {
     let single = |w: &str| map_core::matcher::singular(w);
-    let mut listed: Vec<String> = Vec::new();
-    for t in tuples {
-        for w in words(&t.object) {
-            listed.push(single(&w));
-            listed.push(w);
-        }
-    }
+    let listed = listed_words(tuples);
     let phrases: Vec<Vec<String>> = instruction
         .split(" - ")
         .flat_map(|p| p.split(" \u{2013} "))

@@ -208,7 +208,7 @@ fn stop_functions() -> Vec<&'static str> {
 
 /// The step function of a plain stop at an object ([`Step::GoTo`](planner_dsl::typed::Step::GoTo)),
 /// which [`Vocabulary::no_goto`] bars.
-const GOTO_FUNCTION: &str = "move_to_object";
+pub(crate) const GOTO_FUNCTION: &str = "move_to_object";
 
 /// The colours and regions a pair of objects of one name ("between the two yellow
 /// tables") may be selected on: [`Vocabulary::pairs_of`].
@@ -1654,7 +1654,8 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     // plan without a `let`: at least that many before the end, or before the move back
     // (which ends a plan that comes back).
     // With a first step held (`first_side`), the floor counts it.
-    let floor = if first_side(vocab).is_some() {
+    let first = first_side(vocab);
+    let floor = if first.is_some() {
         vocab.min_steps.saturating_sub(1)
     } else {
         vocab.min_steps
@@ -1678,7 +1679,6 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     // as above (at least one where a move back is required, or where the floor on the
     // statements counts more than that step; the floor then counts the rest), or
     // nothing more.
-    let first = first_side(vocab);
     let stmts = match (&first, vocab.return_required) {
         (None, _) => stmts.clone(),
         (Some(_), true) => format!("firstside \"\\n\" ({stmts})"),
@@ -1852,15 +1852,12 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
                 _ => "fpname (\", \" selmap)?".to_string(),
             };
             w.rule("fnamesel", &namesel);
-        } else if any_stop && names.iter().any(|n| vocab.names.contains(n)) {
-            // A stop the plan lacked at an object: picked, with what was said of it (a
-            // bare name would drop a colour said; held-out v11, dev, lb08 wrote
-            // `move_to_object("radar screen")` for "the black radar screen").
-            w.rule("fpick", &picks_but(groups.as_deref(), &get, &others, "f"));
-            w.rule("fobj", "fpick");
         } else if names.iter().any(|n| vocab.names.contains(n)) {
             w.rule("fpick", &picks_but(groups.as_deref(), &get, &others, "f"));
-            w.rule("fobj", "fpick | fpname");
+            // A stop the plan lacked at an object is picked, with what was said of it (a
+            // bare name would drop a colour said; held-out v11, dev, lb08 wrote
+            // `move_to_object("radar screen")` for "the black radar screen").
+            w.rule("fobj", if any_stop { "fpick" } else { "fpick | fpname" });
         } else {
             // Rooms alone: the bare name.
             w.rule("fobj", "fpname");

@@ -1211,7 +1211,7 @@ fn held_answer(
             names.push(label.clone());
         }
         v.first_side = Some(grammar::FirstSide {
-            function: "move_to_object".into(),
+            function: grammar::GOTO_FUNCTION.into(),
             names,
             any_stop: true,
         });
