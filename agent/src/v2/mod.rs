@@ -217,6 +217,12 @@ fn no_position_said(instruction: &str, ctx: &PlanContext<'_>) -> bool {
         && !instruction.chars().any(|c| c.is_ascii_digit())
 }
 
+/// Whether the instruction is read in a conversation: with references to what was
+/// visited, an earlier instruction or a history.
+fn in_chat(ctx: &PlanContext<'_>) -> bool {
+    !ctx.references.is_empty() || ctx.earlier.is_some() || ctx.history.is_some()
+}
+
 /// Whether the answer `text` moves back to where it began in a step that no finding of
 /// `findings` is about ([`check::About::Step`]). No word check sees a move back that a
 /// later answer drops: held-out v11 (dev) lb01 and lb03, and v10 (dev) ka14 and kc10,
@@ -318,7 +324,10 @@ fn assess(
         ));
     }
     // Where the person's words already ask for a move back, that check has said so.
-    if must_return && !check::plan_returns(&answer.plan) && !check::return_said(instruction) {
+    if must_return
+        && !check::plan_returns(&answer.plan)
+        && !check::return_said_on(ctx.map, instruction, pose, in_chat(ctx))
+    {
         found.push(Finding::new(
             FindingKind::Word,
             "a first answer moved back to where you began, and nothing disputed that, but this plan never moves back: write move_to_start(); where the person's words say to come back",
@@ -958,7 +967,8 @@ pub fn plan_instruction(
                 ctx,
             );
             // Asked for by this instruction's words alone, as the checks read them.
-            v.return_required = check::return_said(instruction);
+            v.return_required =
+                check::return_said_on(ctx.map, instruction, ctx.pose(), in_chat(ctx));
             v.no_positions = no_position_said(instruction, ctx);
         }
         if ctx.options.said_colours_required && ctx.references.is_empty() {
