@@ -121,6 +121,16 @@ pub enum Bar {
         /// The map label.
         label: String,
     },
+    /// The person asked to stop between the two of this map label, named only there
+    /// (`check::pairs_said_between`), and the plan stops between nothing: the re-ask's
+    /// continuation from that label's picks (or from where the plan lacks it) begins
+    /// with `move_between_the_two` of it (`Vocabulary::first_side`). Held-out v13 (dev
+    /// since its third run) nb11 and na11: the finding, placed nowhere, sent whole
+    /// answers back, and their re-asks and draws lost the pair or other steps.
+    PairStop {
+        /// The map label.
+        label: String,
+    },
 }
 
 impl Finding {
@@ -145,7 +155,8 @@ impl Finding {
                 Bar::UnsaidColours { label }
                 | Bar::ColourDropped { label }
                 | Bar::AnchorStop { label }
-                | Bar::SideStop { label } => Some(About::Label(label.clone())),
+                | Bar::SideStop { label }
+                | Bar::PairStop { label } => Some(About::Label(label.clone())),
                 Bar::CountFromStart => None,
             };
         }
@@ -3950,11 +3961,22 @@ pub fn check_answer_after(
         ));
     }
     if between_said(instruction) && !plan_stops_between(plan) {
-        out.push(Finding::new(
+        let f = Finding::new(
             FindingKind::Word,
             "the person said \"between\", but the plan stops between nothing: write move_in_between(a, b) for between two objects, or move_between_the_two(name, ...) for between the two of one kind",
             "between what shall I stop?",
-        ));
+        );
+        // "Between the two white folding tables", the one time they are named: the
+        // finding is at the picks of that object, and the re-ask's continuation stops
+        // between the two there.
+        out.push(
+            match pairs_said_between(map, instruction, pose).as_slice() {
+                [label] => f.barring(Bar::PairStop {
+                    label: label.clone(),
+                }),
+                _ => f,
+            },
+        );
     }
     if refs.is_empty() && earlier.is_none() {
         out.extend(pairs_unsaid(map, instruction, plan, pose));

@@ -809,6 +809,8 @@ fn barred_vocabulary(
             check::Bar::AnchorStop { label } => no_stops.push(label),
             check::Bar::CountFromStart => from_start = true,
             check::Bar::SideStop { label } => no_goto.push(label),
+            // A constraint on where the re-ask's continuation begins (`held_prefix`).
+            check::Bar::PairStop { .. } => {}
         }
     }
     if barred.is_empty()
@@ -1073,6 +1075,7 @@ pub fn plan_instruction(
                         tracing::debug!(
                             steps = h.steps,
                             first_stop = ?h.first_stop,
+                            first_pair = ?h.first_pair,
                             "the re-ask keeps the steps before the first disputed one"
                         );
                     }
@@ -1103,6 +1106,10 @@ struct Held {
     /// What the plan lacks at the first disputed place, where it is a stop of its own
     /// ([`check::Place::stop`]): the continuation's first step stops there.
     first_stop: Option<String>,
+    /// The object the person asked to stop between two of, where a finding at the first
+    /// disputed place says the plan stops between nothing ([`check::Bar::PairStop`]):
+    /// the continuation's first step is `move_between_the_two` of it.
+    first_pair: Option<String>,
     /// How many steps the continuation writes at least ([`Vocabulary::min_steps`], with
     /// [`crate::PlanOptions::reask_keeps_steps`]): the answer's steps from the first
     /// disputed place on that no finding is about, and one for that place.
@@ -1178,12 +1185,21 @@ fn held_prefix(
         .iter()
         .filter(|p| p.at == steps)
         .find_map(|p| p.stop.clone());
+    let first_pair = findings
+        .iter()
+        .zip(&places)
+        .filter(|(_, p)| p.at == steps)
+        .find_map(|(f, _)| match &f.bar {
+            Some(check::Bar::PairStop { label }) => Some(label.clone()),
+            _ => None,
+        });
     Some(Held {
         prefix,
         tuples: answer.tuples,
         steps,
         returns,
         first_stop,
+        first_pair,
         later,
     })
 }
@@ -1224,6 +1240,13 @@ fn held_answer(
             function: grammar::GOTO_FUNCTION.into(),
             names,
             any_stop: true,
+        });
+    }
+    if let (Some(label), true) = (&held.first_pair, ctx.options.reask_stops_first) {
+        v.first_side = Some(grammar::FirstSide {
+            function: grammar::PAIR_FUNCTION.into(),
+            names: names_of_labels(&v, ctx.map, std::slice::from_ref(label), ctx.pose()),
+            any_stop: false,
         });
     }
     continue_plan(backend, req, held.prefix.clone(), &v, ctx, timing)
