@@ -106,8 +106,9 @@ pub fn extract(
     // plan's re-ask is made); its answer stands where it reads.
     let unlisted = check::places_unlisted(instruction, &tuples);
     let cut = check::names_cut(instruction, &tuples);
-    if options.extraction_reask && !(unlisted.is_empty() && cut.is_empty()) {
-        tracing::debug!(answer = %c.text, ?unlisted, ?cut, "objects line lacks a place or a word of a name; re-asking once");
+    let orders = check::orders_unlisted(instruction, &tuples);
+    if options.extraction_reask && !(unlisted.is_empty() && cut.is_empty() && orders.is_empty()) {
+        tracing::debug!(answer = %c.text, ?unlisted, ?cut, ?orders, "objects line lacks a place, a word of a name or an order said; re-asking once");
         // The words of the first of them, in the order of the line, are required of the
         // object that begins there (the place's first word; the whole name).
         let holds = unlisted
@@ -130,6 +131,10 @@ pub fn extract(
                 let said = &n.said;
                 let listed = tuples.get(n.index).map_or_else(String::new, Tuple::paper_form);
                 format!("the person said \"{said}\", but the objects line lists {listed}: list each object by all the words of its name as the person said it, here \"{said}\"")
+            }))
+            .chain(orders.iter().map(|o| {
+                let o = o.name();
+                format!("the person's words count in a direction, but no tuple of the objects line has order {o}: give the object they count that way its count and the order {o}")
             }))
             .collect();
         add_reask(prompts, &mut req.messages, &notes)?;
