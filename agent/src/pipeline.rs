@@ -159,7 +159,9 @@ pub struct PlanOptions {
     /// With no map (extraction): where the person puts an object in a place ("the till in
     /// the snack bar") that no tuple of the answer lists (`check::places_unlisted`), or
     /// where a tuple lists a name less a word the person said ("the third waiting bench"
-    /// as `bench`, `check::names_cut`), one re-ask naming the words. Default on
+    /// as `bench`, `check::names_cut`), or where the person counts in a direction no
+    /// tuple's order counts in ("the farthest-east front loader" with no order,
+    /// `check::orders_unlisted`), one re-ask naming the words. Default on
     /// (`--no-extraction-reask` turns it off).
     pub extraction_reask: bool,
     /// A re-ask that keeps the steps before a stop the plan lacks, said alone in its

@@ -346,8 +346,9 @@ pub(crate) struct ModelArgs {
     #[arg(long)]
     pub(crate) reask_may_shorten: bool,
     /// Take an extraction case's first objects line as it is, with no re-ask for a place
-    /// the person put an object in that it lists no word of, nor for a name it lists
-    /// less a word the person said (the default before stop 75; for comparison).
+    /// the person put an object in that it lists no word of, for a name it lists less a
+    /// word the person said, nor for a direction the person counted in that it lists no
+    /// order of (the default before stop 75; for comparison).
     #[arg(long)]
     pub(crate) no_extraction_reask: bool,
     /// Let a re-ask that keeps the steps before a stop the plan lacks write that stop
