@@ -291,6 +291,14 @@ fn a_reask_stops_between_the_two_where_the_plan_stopped_at_one() {
     let g = reqs[1].grammar.as_deref().unwrap();
     assert!(g.contains("root ::= firstside \"\\n\" ("), "{g}");
     assert!(g.contains("move_between_the_two("), "{g}");
+    // Written as a stop at each table: the one stop between them stands for both, so
+    // the continuation writes at least that stop and the bedroom.
+    let each = format!("{objects}move_to_object(get_obj(\"sofa\", #{{colour: \"red\"}}));\nmove_to_object(get_obj(\"table\", #{{colour: \"yellow\"}}));\nmove_to_object(get_obj(\"table\", #{{ordinal: 2, colour: \"yellow\"}}));\nmove_to_object(\"bedroom\");\n");
+    let (out, reqs) = plan_scripted(&[&each, rest], instruction);
+    assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 1 });
+    let g = reqs[1].grammar.as_deref().unwrap();
+    assert!(g.contains("root ::= firstside \"\\n\" ("), "{g}");
+    assert!(g.contains("stmtn (\"\\n\" stmtn){0,15}"), "{g}");
     // `--reask-stop-anywhere`: no such hold.
     let map = flat_a();
     let robot = SimRobot::new(map.clone());

@@ -1144,8 +1144,26 @@ fn held_prefix(
         .iter()
         .zip(&places)
         .any(|(f, p)| p.at == disputed && matches!(f.bar, Some(check::Bar::AnchorStop { .. })));
+    // A stop between the two X the plan made as stops at them: the one stop between
+    // them stands for every later stop at an X too.
+    let pair = findings
+        .iter()
+        .zip(&places)
+        .filter(|(_, p)| p.at == disputed)
+        .find_map(|(f, _)| match &f.bar {
+            Some(check::Bar::PairStop { label }) => Some(label.clone()),
+            _ => None,
+        });
+    let at_pair = |i: usize| {
+        pair.as_ref().is_some_and(|l| {
+            answer.plan.steps[i]
+                .targets()
+                .iter()
+                .any(|t| check::object_label(ctx.map, &t.name, ctx.pose()).as_ref() == Some(l))
+        })
+    };
     let later = (disputed..answer.plan.steps.len())
-        .filter(|i| !places.iter().any(|p| p.at == *i && !p.lacking))
+        .filter(|i| !places.iter().any(|p| p.at == *i && !p.lacking) && !at_pair(*i))
         .count()
         + usize::from(!goes);
     let steps = answer
@@ -1190,14 +1208,7 @@ fn held_prefix(
         .iter()
         .filter(|p| p.at == steps)
         .find_map(|p| p.stop.clone());
-    let first_pair = findings
-        .iter()
-        .zip(&places)
-        .filter(|(_, p)| p.at == steps)
-        .find_map(|(f, _)| match &f.bar {
-            Some(check::Bar::PairStop { label }) => Some(label.clone()),
-            _ => None,
-        });
+    let first_pair = pair.filter(|_| steps == disputed);
     Some(Held {
         prefix,
         tuples: answer.tuples,
