@@ -371,10 +371,11 @@ fn step_labels(map: &IvlMap, s: &Step, pose: Pose) -> Vec<String> {
     out
 }
 
-/// Steps that stop at or turn to an object the person never named: a target's or a bare
-/// name's label that no word or two of the instruction name ([`named_labels`]: the name,
-/// a synonym, a typo). Outside a conversation only (there the references name what was
-/// visited). Anchors and rooms that filter a pick are not judged here.
+/// Steps that pick an object the person never named: a target's (an anchor's too, a
+/// `near:` pick) or a bare name's label that no word or two of the instruction name
+/// ([`named_labels`]: the name, a synonym, a typo). Outside a conversation only (there
+/// the references name what was visited). A room that filters a pick (`region:`) is not
+/// judged here ([`unsaid_regions`] is).
 /// Held-out v13 (dev since its third run) na11: "then the white rental counter, then the
 /// waxing room" ended `move_to_object(get_obj("wax heater", #{region: "waxing room"}))`,
 /// a wax heater nobody named, and no check said so. On the ten dev navigation suites
@@ -1937,8 +1938,8 @@ pub(crate) fn return_said(instruction: &str) -> bool {
 /// [`name_spans`]) and no distance (no digit, no number word before a unit: "first" and
 /// "square one" are no distance, and typos of count words are not read, "right" is no
 /// "eight") and no word that refers back ([`refers_back_at`]): where a person sends the
-/// robot back and names no place, the place is where it began. "Go back to the table you just visited"
-/// names the table; "back up 2 metres" is a distance.
+/// robot back and names no place, the place is where it began. "Go back to the table you
+/// just visited" names the table; "back up 2 metres" is a distance.
 /// Held-out v13 (dev since its third run): "Once that's done, loop back to me" (na01),
 /// "then come back to the position you're in right now" (nc01) and "then return to your
 /// origin point" (nc03) were read as no return, and each plan ended without one. Read
@@ -4332,10 +4333,15 @@ pub(crate) mod tests {
         let cases = extraction_cases(&["", "2", "3", "4", "7", "8", "9", "10", "11", "12"]);
         assert_eq!(cases.len(), 565);
         for (name, id, instruction, expected) in cases {
-            // Only the names are judged.
+            // Only the names are judged, each as the suite spells it.
             let tuples: Vec<Tuple> = expected
                 .into_iter()
-                .map(|t| Tuple::new(&t.object, None, None))
+                .map(|t| Tuple {
+                    object: t.object,
+                    ordinal: None,
+                    colour: None,
+                    order: None,
+                })
                 .collect();
             let found = names_cut(&instruction, &tuples);
             assert!(found.is_empty(), "{name} {id}: {found:?}");
