@@ -133,6 +133,14 @@ pub struct Vocabulary {
     /// 4 cases, and with the word allowed anywhere in that tuple it wrote the next
     /// object's name and then the place's, `snack bar car deck`).
     pub object_word_after: usize,
+    /// An order some tuple of the objects line must count in, this way round or the
+    /// other: an extraction's re-ask after the person counted in a direction no tuple
+    /// of the first answer counts in (`check::orders_unlisted`). Measured on held-out
+    /// v13 (dev) and v15's second run, the re-ask that only named the order (stop 77)
+    /// got the same answer each of the 5 times it was made. Unset, not offered (a
+    /// direction the vocabulary bars), or with [`Vocabulary::object_word_required`]
+    /// held: no such hold.
+    pub order_required: Option<ObjectOrder>,
     /// The colours a tuple on the objects line may carry besides `None` (unset: every
     /// colour word and every colour of `colours`). By default
     /// (`PlanOptions::said_tuple_colours`), those the person said as
@@ -346,6 +354,7 @@ impl Vocabulary {
             object_words: None,
             object_word_required: None,
             object_word_after: 0,
+            order_required: None,
             tuple_colours: None,
             no_stops: Vec::new(),
             no_goto: Vec::new(),
@@ -561,6 +570,20 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
                 .as_ref()
                 .is_some_and(|o| r.split(' ').all(|w| o.iter().any(|x| x == w)))
     });
+    let tuple_orders = offered_orders(vocab, false);
+    // An order required of some tuple (`order_required`), either way round, of those
+    // offered; not with a word required (that hold is kept, as before this one).
+    let required_orders: Option<Vec<&str>> = vocab
+        .order_required
+        .filter(|_| required.is_none())
+        .map(|o| {
+            tuple_orders
+                .iter()
+                .copied()
+                .filter(|t| ObjectOrder::parse(t).is_ok_and(|t| t == o || t == o.reversed()))
+                .collect::<Vec<&str>>()
+        })
+        .filter(|o| !o.is_empty());
     if required.is_some() {
         // (A repetition `{0}` is not written: llguidance did not read it as none.)
         let before = match vocab.object_word_after.min(15) {
@@ -571,13 +594,19 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
             "objects",
             &format!("\"objects: [\" {before}rtuple (\", \" tuple){{0,15}} \"]\""),
         );
+    } else if let Some(orders) = &required_orders {
+        // One tuple (`otuple`) counts in the order, anywhere in the line.
+        w.rule(
+            "objects",
+            "\"objects: [\" (tuple \", \"){0,15} otuple (\", \" tuple){0,15} \"]\"",
+        );
+        w.rule("oorder", &alt(orders, false));
     } else {
         w.rule(
             "objects",
             "\"objects: [\" (tuple (\", \" tuple){0,15})? \"]\"",
         );
     }
-    let tuple_orders = offered_orders(vocab, false);
     // Where a direction, a count or the far end is said of some objects only
     // ([`Vocabulary::directions_of`], [`Vocabulary::counts_of`],
     // [`Vocabulary::far_ends_of`]), a tuple counts in a direction, two or more, or
@@ -663,6 +692,16 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
         w.rule("rword", &format!("{}{rest}", alt(&[r], false)));
         let rtuple = tuple("rword", free);
         w.rule("rtuple", &rtuple);
+    }
+    if required_orders.is_some() {
+        // A count said in a direction is a count (not `None`).
+        w.rule(
+            "otuple",
+            "\"(\" tword \", \" oordinal \", \" tcolour \", \" oorder \")\"",
+        );
+        let n = w.pattern("[1-9] [0-9]?", "[1-9][0-9]?");
+        let last = if from_end { " | \"last\"" } else { "" };
+        w.rule("oordinal", &format!("{n}{last}"));
     }
     for (rule, orders) in &order_rules {
         w.rule(rule, &alt(orders, false));

@@ -115,9 +115,16 @@ pub fn extract(
             .iter()
             .map(|p| (p.after, p.word.clone()))
             .chain(cut.iter().map(|n| (n.index, n.said.clone())));
-        if let (Some(mut vocab), Some((after, words))) = (vocab, holds.min_by_key(|(a, _)| *a)) {
-            vocab.object_word_required = Some(words);
-            vocab.object_word_after = after;
+        // Else, with only an order missing, some tuple must count in it (either way).
+        let hold = holds.min_by_key(|(a, _)| *a);
+        if let Some(mut vocab) = vocab.filter(|_| hold.is_some() || !orders.is_empty()) {
+            match hold {
+                Some((after, words)) => {
+                    vocab.object_word_required = Some(words);
+                    vocab.object_word_after = after;
+                }
+                None => vocab.order_required = orders.first().copied(),
+            }
             req.grammar = Some(objects_grammar(&vocab));
             req.lark = options.llguidance.then(|| objects_lark(&vocab));
         }
@@ -1683,6 +1690,39 @@ mod tests {
         // GBNF is built from the same words.
         let gbnf = objects_grammar(&extract_vocabulary(tank, &options));
         assert!(gbnf.contains("oword"), "{gbnf}");
+        // An order required of some tuple (a re-ask after a direction counted in that
+        // no tuple lists): one tuple counts in it, with a count (either way round where
+        // the vocabulary offers both; here the person's words offer only the one).
+        let west = "the westernmost ski rack, then the red bench";
+        let mut v = extract_vocabulary(west, &options);
+        assert_eq!(
+            check::orders_unlisted(west, &tuples("[(ski rack, None, None), (bench, None, red)]")),
+            [map_core::ObjectOrder::WestToEast]
+        );
+        v.order_required = Some(map_core::ObjectOrder::WestToEast);
+        let lark = objects_lark(&v);
+        let line = |l: &str| grammar::tests::lark_accepts(&lark, &format!("objects: [{l}]\n"));
+        assert!(line("(ski rack, 1, None, west_to_east), (bench, None, red)").is_ok());
+        assert!(line("(bench, None, red), (ski rack, 1, None, west_to_east)").is_ok());
+        assert!(line("(ski rack, None, None), (bench, None, red)").is_err());
+        assert!(line("(ski rack, None, None, west_to_east), (bench, None, red)").is_err());
+        assert!(line("(ski rack, 1, None, left_to_right), (bench, None, red)").is_err());
+        assert!(line("").is_err());
+        let g = objects_grammar(&v);
+        assert!(grammar::tests::undefined_rules(&g).is_empty(), "{g}");
+        assert!(g.contains("oorder"), "{g}");
+        // An order the vocabulary does not offer: no hold.
+        v.order_required = Some(map_core::ObjectOrder::LargestToSmallest);
+        assert_eq!(
+            objects_lark(&v),
+            objects_lark(&extract_vocabulary(west, &options))
+        );
+        // With a word required too, only the word is held.
+        v.order_required = Some(map_core::ObjectOrder::WestToEast);
+        v.object_word_required = Some("ski rack".into());
+        let both = objects_lark(&v);
+        v.order_required = None;
+        assert_eq!(both, objects_lark(&v));
     }
 
     #[test]
