@@ -123,7 +123,10 @@ pub fn extract(
                     vocab.object_word_required = Some(words);
                     vocab.object_word_after = after;
                 }
-                None => vocab.order_required = orders.first().copied(),
+                None => {
+                    vocab.order_required = orders.first().copied();
+                    vocab.order_tuples = tuples.len();
+                }
             }
             req.grammar = Some(objects_grammar(&vocab));
             req.lark = options.llguidance.then(|| objects_lark(&vocab));
@@ -1695,11 +1698,21 @@ mod tests {
         // the vocabulary offers both; here the person's words offer only the one).
         let west = "the westernmost ski rack, then the red bench";
         let mut v = extract_vocabulary(west, &options);
+        // An order comes only after a count, held or not.
+        let free = objects_lark(&v);
+        let unheld = |l: &str| grammar::tests::lark_accepts(&free, &format!("objects: [{l}]\n"));
+        assert!(unheld("(ski rack, 1, None, west_to_east)").is_ok());
+        assert!(unheld("(ski rack, None, None)").is_ok());
+        assert!(unheld("(ski rack, None, None, west_to_east)").is_err());
         assert_eq!(
-            check::orders_unlisted(west, &tuples("[(ski rack, None, None), (bench, None, red)]")),
+            check::orders_unlisted(
+                west,
+                &tuples("[(ski rack, None, None), (bench, None, red)]")
+            ),
             [map_core::ObjectOrder::WestToEast]
         );
         v.order_required = Some(map_core::ObjectOrder::WestToEast);
+        v.order_tuples = 2;
         let lark = objects_lark(&v);
         let line = |l: &str| grammar::tests::lark_accepts(&lark, &format!("objects: [{l}]\n"));
         assert!(line("(ski rack, 1, None, west_to_east), (bench, None, red)").is_ok());
@@ -1708,9 +1721,21 @@ mod tests {
         assert!(line("(ski rack, None, None, west_to_east), (bench, None, red)").is_err());
         assert!(line("(ski rack, 1, None, left_to_right), (bench, None, red)").is_err());
         assert!(line("").is_err());
+        // As many tuples as the first answer listed.
+        assert!(line("(ski rack, 1, None, west_to_east)").is_err());
+        assert!(line(
+            "(ski rack, None, None), (ski rack, 1, None, west_to_east), (bench, None, red)"
+        )
+        .is_err());
         let g = objects_grammar(&v);
         assert!(grammar::tests::undefined_rules(&g).is_empty(), "{g}");
         assert!(g.contains("oorder"), "{g}");
+        v.order_tuples = 1;
+        let one = objects_lark(&v);
+        let ok1 = |l: &str| grammar::tests::lark_accepts(&one, &format!("objects: [{l}]\n"));
+        assert!(ok1("(ski rack, 1, None, west_to_east)").is_ok());
+        assert!(ok1("(ski rack, 1, None, west_to_east), (bench, None, red)").is_err());
+        v.order_tuples = 2;
         // An order the vocabulary does not offer: no hold.
         v.order_required = Some(map_core::ObjectOrder::LargestToSmallest);
         assert_eq!(
