@@ -2662,7 +2662,7 @@ pub fn places_unlisted(instruction: &str, tuples: &[Tuple]) -> Vec<PlaceUnlisted
 }
 
 /// The words of the objects of `tuples`, each as listed and in the singular: what
-/// [`places_unlisted`] and [`names_cut`] take as listed.
+/// [`places_unlisted`] takes as listed.
 fn listed_words(tuples: &[Tuple]) -> Vec<String> {
     let mut listed = Vec::new();
     for t in tuples {
@@ -2888,8 +2888,14 @@ fn may_name(w: &str) -> bool {
 /// count, a colour or another word that [`says_which`] ("the third *waiting* bench",
 /// "the *oak* barrel"), or a word after them that is followed by a word of
 /// [`AFTER_A_NAME`] ("the ball *return* counting from the west"); neither word is any
-/// of [`FUNCTION_WORDS`], says which object, or is a word of some tuple's object. For one-
-/// and two-word objects; a spaced dash ends a phrase as punctuation does.
+/// of [`FUNCTION_WORDS`], says which object, or is said as a word of some tuple's object
+/// (where all that object's words are said together). For one- and two-word objects; a
+/// spaced dash ends a phrase as punctuation does.
+///
+/// Until stop 78 a word of any tuple's object was never taken as left out, wherever it
+/// was said: held-out v13 (dev) nx34, "the wax bench closest to the red wax heater",
+/// listed `(bench, None, red), (wax heater, None, red)`, and the "wax" of "wax bench" was
+/// taken as the heater's.
 ///
 /// formats.md's tuple holds "the instruction's own word" for the object; read on
 /// held-out v11 and v12's extraction cases (dev), 11 of 20 misses listed a name less one
@@ -2900,39 +2906,54 @@ fn may_name(w: &str) -> bool {
 #[must_use]
 pub fn names_cut(instruction: &str, tuples: &[Tuple]) -> Vec<NameCut> {
     let single = |w: &str| map_core::matcher::singular(w);
-    let listed = listed_words(tuples);
     let phrases: Vec<Vec<String>> = instruction
         .split(" - ")
         .flat_map(|p| p.split(" \u{2013} "))
         .flat_map(clauses)
         .collect();
+    let names: Vec<Vec<String>> = tuples
+        .iter()
+        .map(|t| words(&t.object).iter().map(|w| single(w)).collect())
+        .collect();
+    // Where each name is said: the words some tuple's object is listed by, at each place
+    // they are said together. A word there is that object's, not one left out of another.
+    let at = |c: &[String], i: usize, name: &[String]| {
+        i + name.len() <= c.len()
+            && c[i..i + name.len()]
+                .iter()
+                .map(|w| single(w))
+                .eq(name.iter().cloned())
+    };
+    let covered: Vec<Vec<bool>> = phrases
+        .iter()
+        .map(|c| {
+            let mut cov = vec![false; c.len()];
+            for name in names.iter().filter(|n| !n.is_empty()) {
+                for i in (0..c.len()).filter(|&i| at(c, i, name)) {
+                    cov[i..i + name.len()].iter_mut().for_each(|x| *x = true);
+                }
+            }
+            cov
+        })
+        .collect();
     let mut out = Vec::new();
-    for (index, t) in tuples.iter().enumerate() {
-        let name: Vec<String> = words(&t.object).iter().map(|w| single(w)).collect();
+    for (index, (t, name)) in tuples.iter().zip(&names).enumerate() {
         let n = name.len();
         if n == 0 || n > 2 {
             continue;
         }
-        let found = phrases.iter().find_map(|c| {
-            (0..(c.len() + 1).saturating_sub(n))
-                .find(|&i| {
-                    c[i..i + n]
-                        .iter()
-                        .map(|w| single(w))
-                        .eq(name.iter().cloned())
-                })
-                .map(|i| (c, i))
-        });
-        let Some((c, i)) = found else { continue };
-        let free = |w: &str| {
-            may_name(w) && !listed.contains(&w.to_string()) && !listed.contains(&single(w))
-        };
+        let found = phrases
+            .iter()
+            .zip(&covered)
+            .find_map(|(c, cov)| (0..c.len()).find(|&i| at(c, i, name)).map(|i| (c, cov, i)));
+        let Some((c, cov, i)) = found else { continue };
+        let free = |j: usize| may_name(&c[j]) && !cov[j];
         let opens = |w: &str| DETERMINERS.contains(&w) || says_which(w);
-        let before = (i >= 2 && free(&c[i - 1]) && opens(&c[i - 2]))
+        let before = (i >= 2 && free(i - 1) && opens(&c[i - 2]))
             .then(|| format!("{} {}", c[i - 1], name.join(" ")));
         let after = c
             .get(i + n + 1)
-            .filter(|next| free(&c[i + n]) && AFTER_A_NAME.contains(&next.as_str()))
+            .filter(|next| free(i + n) && AFTER_A_NAME.contains(&next.as_str()))
             .map(|_| format!("{} {}", name.join(" "), single(&c[i + n])));
         if let Some(said) = before.or(after) {
             out.push(NameCut {
@@ -4245,6 +4266,22 @@ pub(crate) mod tests {
                 "[(trolley, 1, None, north_to_south)]"
             ),
             ["treatment trolley/trolley/0"]
+        );
+        // A word of another object's name, said here apart from that name (held-out
+        // v13, dev, nx34).
+        assert_eq!(
+            cut(
+                "the wax bench closest to the red wax heater",
+                "[(bench, None, red), (wax heater, None, red)]"
+            ),
+            ["wax bench/bench/0"]
+        );
+        assert_eq!(
+            cut(
+                "the wax heater, then the wax bench",
+                "[(wax heater, None, None), (bench, None, None)]"
+            ),
+            ["wax bench/bench/1"]
         );
         // A word after it, followed by how it is counted or placed (a plural said).
         assert_eq!(
