@@ -161,8 +161,11 @@ pub struct PlanOptions {
     /// where a tuple lists a name less a word the person said ("the third waiting bench"
     /// as `bench`, `check::names_cut`), or where the person counts in a direction no
     /// tuple's order counts in ("the farthest-east front loader" with no order,
-    /// `check::orders_unlisted`), one re-ask naming the words. Default on
-    /// (`--no-extraction-reask` turns it off).
+    /// `check::orders_unlisted`), one re-ask naming the words. Its grammar holds the
+    /// first of them (a tuple that begins with the place's word, the name whole, a count
+    /// in the order) and keeps every tuple no finding is about as the first answer
+    /// wrote it (`grammar::Vocabulary::held_lines`). Default on (`--no-extraction-reask`
+    /// turns it off).
     pub extraction_reask: bool,
     /// A re-ask that keeps the steps before a stop the plan lacks, said alone in its
     /// clause ("then the black radar screen"), has the continuation begin with a stop

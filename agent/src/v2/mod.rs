@@ -34,7 +34,7 @@ use self::check::{check_answer_after, runtime_finding, Finding, FindingKind};
 use self::grammar::{
     answer_grammar, answer_lark, answer_objects_grammar, answer_objects_lark, group_list,
     label_names, name_groups, object_words_said, objects_grammar, objects_lark, plan_grammar,
-    plan_lark, words_said, Vocabulary,
+    plan_lark, words_said, LineHold, Vocabulary,
 };
 
 /// The messages of one request: system (+ scene), the nearest worked examples, the
@@ -116,16 +116,41 @@ pub fn extract(
             .map(|p| (p.after, p.word.clone()))
             .chain(cut.iter().map(|n| (n.index, n.said.clone())));
         // Else, with only an order missing, some tuple must count in it (either way).
+        // Each tuple no finding is about is kept as the first answer wrote it.
         let hold = holds.min_by_key(|(a, _)| *a);
         if let Some(mut vocab) = vocab.filter(|_| hold.is_some() || !orders.is_empty()) {
+            let kept = |i: usize| {
+                if cut.iter().any(|n| n.index == i) {
+                    LineHold::Free
+                } else {
+                    LineHold::Kept(tuples[i].clone())
+                }
+            };
             match hold {
                 Some((after, words)) => {
                     vocab.object_word_required = Some(words);
                     vocab.object_word_after = after;
+                    // A name cut short is that tuple, held; a place goes in at `after`.
+                    let cut_at = cut.iter().any(|n| n.index == after)
+                        && !unlisted.iter().any(|u| u.after == after);
+                    let mut line: Vec<LineHold> = (0..tuples.len()).map(kept).collect();
+                    if cut_at {
+                        line[after] = LineHold::Renamed(tuples[after].clone());
+                    } else {
+                        line.insert(after.min(line.len()), LineHold::Word);
+                    }
+                    vocab.held_lines = vec![line];
                 }
                 None => {
                     vocab.order_required = orders.first().copied();
                     vocab.order_tuples = tuples.len();
+                    vocab.held_lines = (0..tuples.len())
+                        .map(|i| {
+                            let mut line: Vec<LineHold> = (0..tuples.len()).map(kept).collect();
+                            line[i] = LineHold::Order;
+                            line
+                        })
+                        .collect();
                 }
             }
             req.grammar = Some(objects_grammar(&vocab));
@@ -1748,6 +1773,61 @@ mod tests {
         let both = objects_lark(&v);
         v.order_required = None;
         assert_eq!(both, objects_lark(&v));
+
+        // Held lines: what no finding is about is kept as the first answer wrote it.
+        let globe = "the moon globe next to the gold brass telescope";
+        let mut v = extract_vocabulary(globe, &options);
+        v.object_word_required = Some("brass telescope".into());
+        v.object_word_after = 1;
+        v.held_lines = vec![vec![
+            LineHold::Kept(crate::tuples::Tuple::new("moon globe", None, None)),
+            LineHold::Word,
+        ]];
+        let lark = objects_lark(&v);
+        let line = |l: &str| grammar::tests::lark_accepts(&lark, &format!("objects: [{l}]\n"));
+        assert!(line("(moon globe, None, None), (brass telescope, None, gold)").is_ok());
+        assert!(line("(moon globe, None, gold), (brass telescope, None, gold)").is_err());
+        assert!(line("(moon globe, None, None), (telescope, None, gold)").is_err());
+        assert!(line("(moon globe, None, None)").is_err());
+        let g = objects_grammar(&v);
+        assert!(grammar::tests::undefined_rules(&g).is_empty(), "{g}");
+        // The tuple renamed keeps its count, colour and order.
+        v.held_lines = vec![vec![
+            LineHold::Kept(crate::tuples::Tuple::new("moon globe", None, None)),
+            LineHold::Renamed(crate::tuples::Tuple::new("telescope", None, Some("gold"))),
+        ]];
+        let lark = objects_lark(&v);
+        let line = |l: &str| grammar::tests::lark_accepts(&lark, &format!("objects: [{l}]\n"));
+        assert!(line("(moon globe, None, None), (brass telescope, None, gold)").is_ok());
+        assert!(line("(moon globe, None, None), (brass telescope, 1, gold)").is_err());
+        assert!(line("(moon globe, None, None), (brass telescope, None, None)").is_err());
+        assert!(line("(moon globe, None, None), (telescope, None, gold)").is_err());
+        // An order held at one of the tuples, the others kept.
+        let mut v = extract_vocabulary(west, &options);
+        v.order_required = Some(map_core::ObjectOrder::WestToEast);
+        v.held_lines = (0..2)
+            .map(|i| {
+                let mut l = vec![
+                    LineHold::Kept(crate::tuples::Tuple::new("ski rack", None, None)),
+                    LineHold::Kept(crate::tuples::Tuple::new("bench", None, Some("red"))),
+                ];
+                l[i] = LineHold::Order;
+                l
+            })
+            .collect();
+        let lark = objects_lark(&v);
+        let line = |l: &str| grammar::tests::lark_accepts(&lark, &format!("objects: [{l}]\n"));
+        assert!(line("(ski rack, 1, None, west_to_east), (bench, None, red)").is_ok());
+        assert!(line("(ski rack, None, None), (bench, 1, red, west_to_east)").is_ok());
+        assert!(line("(ski rack, 1, None, west_to_east), (bench, None, None)").is_err());
+        assert!(line("(ski rack, None, None), (bench, None, red)").is_err());
+        // A line holding a word with no word held: the line is not used.
+        v.held_lines = vec![vec![LineHold::Word]];
+        v.order_required = None;
+        assert_eq!(
+            objects_lark(&v),
+            objects_lark(&extract_vocabulary(west, &options))
+        );
     }
 
     #[test]
