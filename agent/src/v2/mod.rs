@@ -144,7 +144,11 @@ pub fn extract(
                 None => {
                     vocab.order_required = orders.first().copied();
                     vocab.order_tuples = tuples.len();
+                    // On a tuple the direction is said of, where that is known.
+                    let of = check::directions_said_of(instruction, &tuples);
+                    let on = |i: &usize| of.as_ref().is_none_or(|o| o.contains(&tuples[*i].object));
                     vocab.held_lines = (0..tuples.len())
+                        .filter(on)
                         .map(|i| {
                             let mut line: Vec<LineHold> = (0..tuples.len()).map(kept).collect();
                             line[i] = LineHold::Order;
