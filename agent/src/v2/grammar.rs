@@ -35,7 +35,11 @@ pub enum LineHold {
     /// order kept. Measured on held-out v12 (dev), mx28's re-ask after "dentist stool"
     /// listed as `(stool, None, black)` gave `(dentist stool, 1, black)`.
     Renamed(crate::tuples::Tuple),
-    /// A tuple with a count in [`Vocabulary::order_required`] (either way round).
+    /// A tuple with a count in [`Vocabulary::order_required`] (either way round). A
+    /// line holds as many tuples as the first answer, one of them so: measured on
+    /// held-out v13 (dev), with the order held of some tuple anywhere, the default model
+    /// kept its first answer's tuples and added another in the order ("westernmost dome
+    /// seat"), or listed stray words ("east to the") to the limit and never came to it.
     Order,
 }
 
@@ -188,16 +192,11 @@ pub struct Vocabulary {
     /// other: an extraction's re-ask after the person counted in a direction no tuple
     /// of the first answer counts in (`check::orders_unlisted`). Measured on held-out
     /// v13 (dev) and v15's second run, the re-ask that only named the order (stop 77)
-    /// got the same answer each of the 5 times it was made. Unset, not offered (a
+    /// got the same answer each of the 5 times it was made. Held at the
+    /// [`LineHold::Order`] of [`Vocabulary::held_lines`]. Unset, not offered (a
     /// direction the vocabulary bars), or with [`Vocabulary::object_word_required`]
     /// held: no such hold.
     pub order_required: Option<ObjectOrder>,
-    /// With [`Vocabulary::order_required`]: the line lists exactly this many tuples (at
-    /// least one), the first answer's count, one of them in that order. Measured on
-    /// held-out v13 (dev), with the order held of some tuple anywhere, the default model
-    /// kept its first answer's tuples and added another in the order ("westernmost dome
-    /// seat"), or listed stray words ("east to the") to the limit and never came to it.
-    pub order_tuples: usize,
     /// An extraction re-ask's lines, one of which the objects line is: each the first
     /// answer's tuples, in order, each kept as written ([`LineHold::Kept`]) unless a
     /// finding is about it. Measured on held-out v13 (dev), the re-ask that held only the
@@ -205,8 +204,8 @@ pub struct Vocabulary {
     /// moon globe next to the gold brass telescope" the telescope's colour (nx36), left
     /// out the room the first answer had listed (nx15), and listed the place before the
     /// object it was said after, under a name of the place's word (nx32). Empty, or a
-    /// line that holds a tuple to a word or an order that is not held: the lines above
-    /// ([`Vocabulary::object_word_after`], [`Vocabulary::order_tuples`]).
+    /// line that holds a tuple to a word or an order that is not held: the line
+    /// [`Vocabulary::object_word_after`] says, or none held.
     pub held_lines: Vec<Vec<LineHold>>,
     /// The colours a tuple on the objects line may carry besides `None` (unset: every
     /// colour word and every colour of `colours`). By default
@@ -422,7 +421,6 @@ impl Vocabulary {
             object_word_required: None,
             object_word_after: 0,
             order_required: None,
-            order_tuples: 0,
             held_lines: Vec::new(),
             tuple_colours: None,
             no_stops: Vec::new(),
@@ -695,27 +693,6 @@ fn objects_rules(w: &mut Writer, vocab: &Vocabulary, map_names: &[String]) {
             "objects",
             &format!("\"objects: [\" {before}rtuple (\", \" tuple){{0,15}} \"]\""),
         );
-    } else if let Some(orders) = &required_orders {
-        // As many tuples as `order_tuples`, one of them (`otuple`) in the order.
-        let k = vocab.order_tuples.clamp(1, 16);
-        let times = |n: usize, what: &str| match n {
-            0 => String::new(),
-            n => format!("({what}){{{n}}} "),
-        };
-        let lines: Vec<String> = (0..k)
-            .map(|i| {
-                format!(
-                    "{}otuple {}",
-                    times(i, "tuple \", \""),
-                    times(k - 1 - i, "\", \" tuple")
-                )
-            })
-            .collect();
-        w.rule(
-            "objects",
-            &format!("\"objects: [\" ({}) \"]\"", lines.join(" | ")),
-        );
-        w.rule("oorder", &alt(orders, false));
     } else {
         w.rule(
             "objects",

@@ -119,13 +119,15 @@ pub fn extract(
         // Each tuple no finding is about is kept as the first answer wrote it.
         let hold = holds.min_by_key(|(a, _)| *a);
         if let Some(mut vocab) = vocab.filter(|_| hold.is_some() || !orders.is_empty()) {
-            let kept = |i: usize| {
-                if cut.iter().any(|n| n.index == i) {
-                    LineHold::Free
-                } else {
-                    LineHold::Kept(tuples[i].clone())
-                }
-            };
+            let kept: Vec<LineHold> = (0..tuples.len())
+                .map(|i| {
+                    if cut.iter().any(|n| n.index == i) {
+                        LineHold::Free
+                    } else {
+                        LineHold::Kept(tuples[i].clone())
+                    }
+                })
+                .collect();
             match hold {
                 Some((after, words)) => {
                     vocab.object_word_required = Some(words);
@@ -133,7 +135,7 @@ pub fn extract(
                     // A name cut short is that tuple, held; a place goes in at `after`.
                     let cut_at = cut.iter().any(|n| n.index == after)
                         && !unlisted.iter().any(|u| u.after == after);
-                    let mut line: Vec<LineHold> = (0..tuples.len()).map(kept).collect();
+                    let mut line = kept;
                     if cut_at {
                         line[after] = LineHold::Renamed(tuples[after].clone());
                     } else {
@@ -143,18 +145,25 @@ pub fn extract(
                 }
                 None => {
                     vocab.order_required = orders.first().copied();
-                    vocab.order_tuples = tuples.len();
-                    // On a tuple the direction is said of, where that is known.
+                    // On a tuple the direction is said of, where that is known (else on
+                    // any); with none listed, on the one tuple of the line.
                     let of = check::directions_said_of(instruction, &tuples);
                     let on = |i: &usize| of.as_ref().is_none_or(|o| o.contains(&tuples[*i].object));
-                    vocab.held_lines = (0..tuples.len())
-                        .filter(on)
-                        .map(|i| {
-                            let mut line: Vec<LineHold> = (0..tuples.len()).map(kept).collect();
-                            line[i] = LineHold::Order;
-                            line
-                        })
-                        .collect();
+                    let mut at: Vec<usize> = (0..tuples.len()).filter(on).collect();
+                    if at.is_empty() {
+                        at = (0..tuples.len()).collect();
+                    }
+                    vocab.held_lines = if kept.is_empty() {
+                        vec![vec![LineHold::Order]]
+                    } else {
+                        at.into_iter()
+                            .map(|i| {
+                                let mut line = kept.clone();
+                                line[i] = LineHold::Order;
+                                line
+                            })
+                            .collect()
+                    };
                 }
             }
             req.grammar = Some(objects_grammar(&vocab));
@@ -1741,7 +1750,17 @@ mod tests {
             [map_core::ObjectOrder::WestToEast]
         );
         v.order_required = Some(map_core::ObjectOrder::WestToEast);
-        v.order_tuples = 2;
+        // `k` tuples, any one of them in the order.
+        let anywhere = |k: usize| -> Vec<Vec<LineHold>> {
+            (0..k)
+                .map(|i| {
+                    let mut l = vec![LineHold::Free; k];
+                    l[i] = LineHold::Order;
+                    l
+                })
+                .collect()
+        };
+        v.held_lines = anywhere(2);
         let lark = objects_lark(&v);
         let line = |l: &str| grammar::tests::lark_accepts(&lark, &format!("objects: [{l}]\n"));
         assert!(line("(ski rack, 1, None, west_to_east), (bench, None, red)").is_ok());
@@ -1759,12 +1778,12 @@ mod tests {
         let g = objects_grammar(&v);
         assert!(grammar::tests::undefined_rules(&g).is_empty(), "{g}");
         assert!(g.contains("oorder"), "{g}");
-        v.order_tuples = 1;
+        v.held_lines = anywhere(1);
         let one = objects_lark(&v);
         let ok1 = |l: &str| grammar::tests::lark_accepts(&one, &format!("objects: [{l}]\n"));
         assert!(ok1("(ski rack, 1, None, west_to_east)").is_ok());
         assert!(ok1("(ski rack, 1, None, west_to_east), (bench, None, red)").is_err());
-        v.order_tuples = 2;
+        v.held_lines = anywhere(2);
         // An order the vocabulary does not offer: no hold.
         v.order_required = Some(map_core::ObjectOrder::LargestToSmallest);
         assert_eq!(
