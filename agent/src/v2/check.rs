@@ -2711,29 +2711,35 @@ pub fn orders_unlisted(instruction: &str, tuples: &[Tuple]) -> Vec<ObjectOrder> 
 pub fn directions_said_of(instruction: &str, tuples: &[Tuple]) -> Option<Vec<String>> {
     let names: Vec<(Vec<String>, &str)> = tuples
         .iter()
-        .map(|t| {
-            let w = words(&t.object)
-                .iter()
-                .map(|w| map_core::matcher::singular(w))
-                .collect();
-            (w, t.object.as_str())
-        })
-        .filter(|(w, _): &(Vec<String>, &str)| !w.is_empty())
+        .map(|t| (tuple_name(t), t.object.as_str()))
+        .filter(|(w, _)| !w.is_empty())
         .collect();
     let name_at = |w: &[String], j: usize| {
         names
             .iter()
-            .filter(|(n, _)| {
-                j + n.len() <= w.len()
-                    && w[j..j + n.len()]
-                        .iter()
-                        .map(|x| map_core::matcher::singular(x))
-                        .eq(n.iter().cloned())
-            })
+            .filter(|(n, _)| said_at(w, j, n))
             .max_by_key(|(n, _)| n.len())
             .map(|(n, o)| ((*o).to_string(), n.len()))
     };
     said_of(instruction, SaidOf::Direction, name_at).filter(|o| !o.is_empty())
+}
+
+/// The words of `t`'s object, each in the singular: how [`said_at`] matches it.
+fn tuple_name(t: &Tuple) -> Vec<String> {
+    words(&t.object)
+        .iter()
+        .map(|w| map_core::matcher::singular(w))
+        .collect()
+}
+
+/// Whether the words `name` (in the singular) are said at word `i` of `w`, each word of
+/// `w` read in the singular.
+fn said_at(w: &[String], i: usize, name: &[String]) -> bool {
+    i + name.len() <= w.len()
+        && w[i..i + name.len()]
+            .iter()
+            .map(|x| map_core::matcher::singular(x))
+            .eq(name.iter().cloned())
 }
 
 /// A place the objects line lists no word of ([`places_unlisted`]).
@@ -2952,25 +2958,15 @@ pub fn names_cut(instruction: &str, tuples: &[Tuple]) -> Vec<NameCut> {
         .flat_map(|p| p.split(" \u{2013} "))
         .flat_map(clauses)
         .collect();
-    let names: Vec<Vec<String>> = tuples
-        .iter()
-        .map(|t| words(&t.object).iter().map(|w| single(w)).collect())
-        .collect();
+    let names: Vec<Vec<String>> = tuples.iter().map(tuple_name).collect();
     // Where each name is said: the words some tuple's object is listed by, at each place
     // they are said together. A word there is that object's, not one left out of another.
-    let at = |c: &[String], i: usize, name: &[String]| {
-        i + name.len() <= c.len()
-            && c[i..i + name.len()]
-                .iter()
-                .map(|w| single(w))
-                .eq(name.iter().cloned())
-    };
     let covered: Vec<Vec<bool>> = phrases
         .iter()
         .map(|c| {
             let mut cov = vec![false; c.len()];
             for name in names.iter().filter(|n| !n.is_empty()) {
-                for i in (0..c.len()).filter(|&i| at(c, i, name)) {
+                for i in (0..c.len()).filter(|&i| said_at(c, i, name)) {
                     cov[i..i + name.len()].iter_mut().for_each(|x| *x = true);
                 }
             }
@@ -2983,10 +2979,11 @@ pub fn names_cut(instruction: &str, tuples: &[Tuple]) -> Vec<NameCut> {
         if n != 1 {
             continue;
         }
-        let found = phrases
-            .iter()
-            .zip(&covered)
-            .find_map(|(c, cov)| (0..c.len()).find(|&i| at(c, i, name)).map(|i| (c, cov, i)));
+        let found = phrases.iter().zip(&covered).find_map(|(c, cov)| {
+            (0..c.len())
+                .find(|&i| said_at(c, i, name))
+                .map(|i| (c, cov, i))
+        });
         let Some((c, cov, i)) = found else { continue };
         let free = |j: usize| may_name(&c[j]) && !cov[j];
         let opens = |w: &str| DETERMINERS.contains(&w) || says_which(w);
