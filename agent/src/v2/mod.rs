@@ -762,7 +762,8 @@ fn narrow_exclusions(v: &mut Vocabulary, instruction: &str, known: &[String]) {
 }
 
 /// The ordinals a selection may count: 1 and -1, and k and -k for each count k the
-/// person said ([`check::ordinal_said`]); no count from the end where the only one said
+/// person said or 2 where a side or the far end is ([`check::counts_offered`],
+/// [`check::ordinal_said`]); no count from the end where the only one said
 /// is "furthest" + a side ([`check::only_sides_counted_from_the_end`]), or where no word
 /// speaks of an end at all ([`check::far_end_said`]: "the westernmost stretcher" is the
 /// first from the west, `#{ordinal: 1, order: "west_to_east"}`, the one way the grammar
@@ -771,7 +772,7 @@ fn narrow_exclusions(v: &mut Vocabulary, instruction: &str, known: &[String]) {
 /// westernmost" as `#{ordinal: -1, order: "west_to_east"}`, the easternmost, and were
 /// re-asked for it.
 fn said_ordinals(instruction: &str) -> Vec<i64> {
-    let counts = check::counts_said(instruction);
+    let counts = check::counts_offered(instruction);
     let from_start =
         check::only_sides_counted_from_the_end(instruction) || !check::far_end_said(instruction);
     (1..=20)
@@ -1981,10 +1982,12 @@ mod tests {
         let ks = narrowed("go to the third to last chair", &[])
             .ordinals
             .unwrap();
-        for k in [1, -1, 3, -3] {
-            assert!(ks.contains(&k), "{ks:?}");
-        }
-        assert!(!ks.contains(&2) && !ks.contains(&-2), "{ks:?}");
+        // The far end said: 2 from either end too ([`check::counts_offered`]).
+        assert_eq!(ks, vec![1, -1, 2, -2, 3, -3]);
+        let ks = narrowed("go to the third chair by the bed", &[])
+            .ordinals
+            .unwrap();
+        assert_eq!(ks, vec![1, 3], "no side, no far end: no 2");
         assert!(v.no_directions && v.no_sizes);
         // Colours stay the map's (the checks judge them).
         assert_eq!(v.colours, Vocabulary::for_map(&map()).colours);
@@ -2044,7 +2047,7 @@ mod tests {
         assert!(!v.no_far_end && !narrowed("the second farthest table", &[]).no_far_end);
         assert!(narrowed("the third stool please", &[]).no_far_end);
         let ks = v.ordinals.unwrap();
-        assert!(ks.contains(&-2) && !ks.contains(&2), "{ks:?}");
+        assert!(ks.contains(&-2) && ks.contains(&2), "{ks:?}");
     }
 
     #[test]
@@ -2385,15 +2388,16 @@ mod tests {
     fn furthest_and_a_side_is_offered_as_a_count_from_that_side() {
         // Every count from the end said is "furthest" + a side: positive counts only,
         // and no far_to_near (the re-ask's bar, given before the first answer).
-        let v = narrowed("go to the shelf furthest north, then the second chair", &[]);
-        assert_eq!(v.ordinals, Some(vec![1, 2]));
+        let v = narrowed("go to the shelf furthest north, then the third chair", &[]);
+        assert_eq!(v.ordinals, Some(vec![1, 2, 3]));
         assert!(v.no_far_end);
-        // "End" is no count from an end (held-out v10, dev, kb02).
+        // "End" is no count from an end (held-out v10, dev, kb02): a side is said, so
+        // the second from it is offered, as a positive count.
         let v = narrowed(
             "the turnstile that's furthest west, and end on the platform",
             &[],
         );
-        assert_eq!(v.ordinals, Some(vec![1]));
+        assert_eq!(v.ordinals, Some(vec![1, 2]));
         assert!(v.no_far_end);
         // Any other count from the end keeps -1 and far_to_near on offer.
         for instruction in [
@@ -2419,7 +2423,11 @@ mod tests {
         // first from the west; held-out v10, dev, ka05 and kc05).
         assert_eq!(narrowed("the red chair", &[]).ordinals, Some(vec![1]));
         let v = narrowed("the westernmost chair, then the third table", &[]);
-        assert_eq!(v.ordinals, Some(vec![1, 3]));
+        assert_eq!(
+            v.ordinals,
+            Some(vec![1, 2, 3]),
+            "a side said: its second too"
+        );
         grammar::tests::assert_offers(
             &narrowed_grammar("the westernmost chair, then the red sofa"),
             one_pick,
@@ -2998,6 +3006,6 @@ mod tests {
         let v = narrowed("now the third one", &[9]);
         assert_eq!(v.ordinals, Some(vec![1, 3]));
         let v = narrowed("now the last one", &[9]);
-        assert_eq!(v.ordinals, Some(vec![1, -1]));
+        assert_eq!(v.ordinals, Some(vec![1, -1, 2, -2]));
     }
 }
