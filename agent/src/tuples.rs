@@ -503,7 +503,7 @@ pub fn said_count(word: &str) -> Option<i64> {
 /// A count from the end said in more than one word, beginning at `w[i]` (words as
 /// [`crate::words::words`] splits them: "next-to-last" is three), and how many words it
 /// takes: "second to last" and "second from last" (-2), "second last" (-2), "next to
-/// last" (-2) and "last but one" (-2, "last but two" -3). design.md's "the second to last
+/// last" (-2), "before the last" (-2) and "last but one" (-2, "last but two" -3). design.md's "the second to last
 /// X" in each of the ways English says it: the one form, k from the end. Held-out v12
 /// (dev since its third run) ma09 and mc09: "the last-but-one ball return counting from
 /// the west" and "the next-to-last staff locker counting from the west" were read as no
@@ -514,6 +514,9 @@ pub fn count_from_the_end_at(w: &[String], i: usize) -> Option<(i64, usize)> {
     let count = |j: usize| at(j).and_then(said_count).filter(|&k| k >= 1);
     match (at(i)?, at(i + 1), at(i + 2)) {
         ("next", Some("to"), Some("last")) => Some((-2, 3)),
+        // "the one right before the last", "just before the final one" (held-out v16,
+        // dev, vb08; v14 pa09): the one before the last is the second to last.
+        ("before", Some("the"), Some("last" | "final" | "end")) => Some((-2, 3)),
         ("last", Some("but"), Some(_)) => count(i + 2).map(|k| (-(k + 1), 3)),
         (_, Some("to" | "from"), Some("last")) => count(i).filter(|&k| k >= 2).map(|k| (-k, 3)),
         (_, Some("last"), _) => count(i).filter(|&k| k >= 2).map(|k| (-k, 2)),
@@ -656,6 +659,7 @@ mod tests {
             "the second-from-last chair",
             "the second last chair",
             "the 2nd to last chair",
+            "just before the last chair",
         ] {
             let len = crate::words::words(s).len() - 2;
             assert_eq!(at(s), Some((-2, len)), "{s}");

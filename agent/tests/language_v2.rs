@@ -268,6 +268,42 @@ fn a_reask_writes_at_least_the_steps_no_finding_disputes() {
 }
 
 #[test]
+fn a_reask_moves_to_the_side_asked_for_where_the_plan_stopped_at_the_object() {
+    // Held-out v16 (dev) va12's shape on flat-a: "the south side of the white mannequin"
+    // written as a stop at the mannequin. The finding is at that step; the steps before
+    // it stand, and the continuation begins with the move to that side of it.
+    let instruction = "go to the red sofa, then the south side of the tv, then the bedroom";
+    let objects = "objects: [(sofa, None, red), (tv, None, None), (bedroom, None, None)]\nplan:\n";
+    let first = format!("{objects}move_to_object(get_obj(\"sofa\", #{{colour: \"red\"}}));\nmove_to_object(get_obj(\"tv\"));\nmove_to_object(\"bedroom\");\n");
+    let rest = "move_south(get_obj(\"tv\"));\nmove_to_object(\"bedroom\");";
+    let (out, reqs) = plan_scripted(&[&first, rest], instruction);
+    assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 1 });
+    let kept = reqs[1].messages.last().unwrap();
+    assert_eq!(kept.role, Role::Assistant);
+    assert!(
+        kept.content.ends_with("#{colour: \"red\"}));\n"),
+        "{}",
+        kept.content
+    );
+    let g = reqs[1].grammar.as_deref().unwrap();
+    assert!(g.contains("root ::= firstside \"\\n\" ("), "{g}");
+    let first_side = g
+        .lines()
+        .find(|l| l.starts_with("firstside ::="))
+        .unwrap_or_default();
+    assert!(first_side.contains("move_south("), "{g}");
+    // `--reask-stop-anywhere`: no such hold.
+    let map = flat_a();
+    let robot = SimRobot::new(map.clone());
+    let b = Scripted::new(&[&first, rest]);
+    let mut ctx = v2(&map, &robot);
+    ctx.options.reask_stops_first = false;
+    plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
+    let g = b.requests()[1].grammar.clone().unwrap();
+    assert!(!g.contains("firstside"), "{g}");
+}
+
+#[test]
 fn a_reask_stops_between_the_two_where_the_plan_stopped_at_one() {
     // Held-out v13 (dev) nb11's shape on flat-a: "between the two yellow tables" written
     // as a stop at one table. The finding is at that step; the steps before it stand,

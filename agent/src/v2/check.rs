@@ -120,6 +120,12 @@ pub enum Bar {
     SideStop {
         /// The map label.
         label: String,
+        /// The side the person asked for: a re-ask's continuation from that label's
+        /// picks begins with the move to it (`Vocabulary::first_side`). Held-out v16
+        /// (dev) va12: with only the plain stop barred, the model that began
+        /// `move_to_object(` went on with a saddle display nobody named, and the task
+        /// ended in a question.
+        side: planner_dsl::typed::Side,
     },
     /// The person asked to stop between the two of this map label, named only there
     /// (`check::pairs_said_between`), and the plan stops between nothing: the re-ask's
@@ -155,7 +161,7 @@ impl Finding {
                 Bar::UnsaidColours { label }
                 | Bar::ColourDropped { label }
                 | Bar::AnchorStop { label }
-                | Bar::SideStop { label }
+                | Bar::SideStop { label, .. }
                 | Bar::PairStop { label } => Some(About::Label(label.clone())),
                 Bar::CountFromStart => None,
             };
@@ -1351,11 +1357,20 @@ fn check_words(
             };
             // "the second to last", "the next to last", "the last but one": counted from
             // the end ([`crate::tuples::count_from_the_end_at`]), its noun after those words.
-            let phrase = crate::tuples::count_from_the_end_at(&w, i);
+            // Or one that ends here ("the one right before the last": held-out v16,
+            // dev, vb08's right `ordinal: -2` was re-asked for the last).
+            let phrase = crate::tuples::count_from_the_end_at(&w, i)
+                .map(|(k, len)| (k, i..i + len))
+                .or_else(|| {
+                    let j = i.checked_sub(2)?;
+                    crate::tuples::count_from_the_end_at(&w, j)
+                        .filter(|&(_, len)| j + len == i + 1)
+                        .map(|(k, len)| (k, j..j + len))
+                });
             let to_last = phrase.is_some();
-            let k = phrase.map(|(k, _)| k).or(k);
+            let k = phrase.as_ref().map(|(k, _)| *k).or(k);
             let (said, at) = match phrase {
-                Some((_, len)) => (w[i..i + len].join(" "), i + len - 1),
+                Some((_, r)) => (w[r.clone()].join(" "), r.end - 1),
                 None => (word.to_string(), i),
             };
             let word = said.as_str();
@@ -1579,8 +1594,9 @@ pub(crate) fn ends_said_of_sides(w: &[String]) -> bool {
 }
 
 /// The side that "furthest" at `i` counts from, and where it is said: a side named in
-/// the three words after it ("the shelf furthest north", "the white microscope furthest
-/// to the east"), before any "from", "then" or "and" ("the chair furthest from you on the
+/// the four words after it ("the shelf furthest north", "the white microscope furthest
+/// to the east", "the tandem furthest along to the east": held-out v16, dev, va02, read
+/// as the far end with three), before any "from", "then" or "and" ("the chair furthest from you on the
 /// left" counts from the robot). Held-out v8 (dev since its third run) hr11: with only
 /// the next word read, "furthest to the east" answered `#{colour: "white", order:
 /// "east_to_west"}` (the easternmost, right) was re-asked for a far end and ended in a
@@ -1589,7 +1605,7 @@ fn side_after(w: &[String], i: usize) -> Option<(usize, ObjectOrder)> {
     w.iter()
         .enumerate()
         .skip(i + 1)
-        .take(3)
+        .take(4)
         .take_while(|(_, x)| !matches!(x.as_str(), "from" | "then" | "and"))
         .find_map(|(j, x)| ObjectOrder::starting_at(x).map(|o| (j, o)))
 }
@@ -4112,7 +4128,10 @@ fn check_side_moves(map: &IvlMap, instruction: &str, plan: &TypedPlan, pose: Pos
             to_user,
         );
         if let Some(of) = &said.of {
-            finding = finding.barring(Bar::SideStop { label: of.clone() });
+            finding = finding.barring(Bar::SideStop {
+                label: of.clone(),
+                side: said.side,
+            });
         }
         if !out.contains(&finding) {
             out.push(finding);
@@ -5209,6 +5228,16 @@ pub(crate) mod tests {
             (
                 "go to the bed furthest from you on the left",
                 "#{ordinal: -1}",
+            ),
+            // Three words on (held-out v16, dev, va02).
+            (
+                "go to the bed furthest along to the east",
+                "#{ordinal: 1, order: \"east_to_west\"}",
+            ),
+            // The one before the last is the second to last (held-out v16, dev, vb08).
+            (
+                "count the beds west to east and go to the one right before the last",
+                "#{ordinal: -2, order: \"west_to_east\"}",
             ),
         ] {
             let f = findings_for_pick(instruction, "bed", select);

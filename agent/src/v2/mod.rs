@@ -862,7 +862,7 @@ fn barred_vocabulary(
             check::Bar::ColourDropped { label } => required.push(label),
             check::Bar::AnchorStop { label } => no_stops.push(label),
             check::Bar::CountFromStart => from_start = true,
-            check::Bar::SideStop { label } => no_goto.push(label),
+            check::Bar::SideStop { label, .. } => no_goto.push(label),
             // A constraint on where the re-ask's continuation begins (`held_prefix`).
             check::Bar::PairStop { .. } => {}
         }
@@ -1130,6 +1130,7 @@ pub fn plan_instruction(
                             steps = h.steps,
                             first_stop = ?h.first_stop,
                             first_pair = ?h.first_pair,
+                            first_side_move = ?h.first_side_move,
                             "the re-ask keeps the steps before the first disputed one"
                         );
                     }
@@ -1164,6 +1165,11 @@ struct Held {
     /// disputed place says the plan stops between nothing ([`check::Bar::PairStop`]):
     /// the continuation's first step is `move_between_the_two` of it.
     first_pair: Option<String>,
+    /// The side move the person asked for at the object of the first disputed step,
+    /// where a finding there says the plan stops at the object itself
+    /// ([`check::Bar::SideStop`]): the continuation's first step is that move to a side
+    /// of it (its function, and the map label).
+    first_side_move: Option<(&'static str, String)>,
     /// How many steps the continuation writes at least ([`Vocabulary::min_steps`], with
     /// [`crate::PlanOptions::reask_keeps_steps`]): the answer's steps from the first
     /// disputed place on that no finding is about, and one for that place.
@@ -1258,6 +1264,14 @@ fn held_prefix(
         .filter(|p| p.at == steps)
         .find_map(|p| p.stop.clone());
     let first_pair = pair.filter(|_| steps == disputed);
+    let first_side_move = findings
+        .iter()
+        .zip(&places)
+        .filter(|(_, p)| p.at == steps && !p.lacking && steps == disputed)
+        .find_map(|(f, _)| match &f.bar {
+            Some(check::Bar::SideStop { label, side }) => Some((side.function(), label.clone())),
+            _ => None,
+        });
     Some(Held {
         prefix,
         tuples: answer.tuples,
@@ -1265,6 +1279,7 @@ fn held_prefix(
         returns,
         first_stop,
         first_pair,
+        first_side_move,
         later,
     })
 }
@@ -1305,6 +1320,14 @@ fn held_answer(
             function: grammar::GOTO_FUNCTION.into(),
             names,
             any_stop: true,
+        });
+    }
+    if let (Some((function, label)), true) = (&held.first_side_move, ctx.options.reask_stops_first)
+    {
+        v.first_side = Some(grammar::FirstSide {
+            function: (*function).to_string(),
+            names: names_of_labels(&v, ctx.map, std::slice::from_ref(label), ctx.pose()),
+            any_stop: false,
         });
     }
     if let (Some(label), true) = (&held.first_pair, ctx.options.reask_stops_first) {
@@ -2157,8 +2180,9 @@ mod tests {
             "objects: [(tv, None, None)]\nplan:\nmove_to_object(get_obj(\"tv\"));\nmove_to_object(get_obj(\"tv\"));",
         );
         assert!(
-            f.iter()
-                .any(|x| x.bar == Some(check::Bar::SideStop { label: "tv".into() })),
+            f.iter().any(
+                |x| matches!(&x.bar, Some(check::Bar::SideStop { label, .. }) if label == "tv")
+            ),
             "{f:?}"
         );
         let r = reask_vocabulary(&v, &m, instruction, &[], &f, m.start_pose).unwrap();
