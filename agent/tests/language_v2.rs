@@ -267,6 +267,24 @@ fn a_reask_writes_at_least_the_steps_no_finding_disputes() {
     );
 }
 
+/// The re-ask's grammar after `first` for `instruction`, the answers `first` then `rest`,
+/// with the re-ask's first step held or not (`PlanOptions::reask_stops_first`); the
+/// re-ask keeps the first step (flat-a's red sofa).
+fn held_reask_grammar(first: &str, rest: &str, instruction: &str, stops_first: bool) -> String {
+    let (out, reqs) = plan_scripted_opts(&[first, rest], instruction, |o| {
+        o.reask_stops_first = stops_first;
+    });
+    assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 1 });
+    let kept = reqs[1].messages.last().unwrap();
+    assert_eq!(kept.role, Role::Assistant);
+    assert!(
+        kept.content.ends_with("#{colour: \"red\"}));\n"),
+        "{}",
+        kept.content
+    );
+    reqs[1].grammar.clone().unwrap()
+}
+
 #[test]
 fn a_reask_moves_to_the_side_asked_for_where_the_plan_stopped_at_the_object() {
     // Held-out v16 (dev) va12's shape on flat-a: "the south side of the white mannequin"
@@ -276,16 +294,7 @@ fn a_reask_moves_to_the_side_asked_for_where_the_plan_stopped_at_the_object() {
     let objects = "objects: [(sofa, None, red), (tv, None, None), (bedroom, None, None)]\nplan:\n";
     let first = format!("{objects}move_to_object(get_obj(\"sofa\", #{{colour: \"red\"}}));\nmove_to_object(get_obj(\"tv\"));\nmove_to_object(\"bedroom\");\n");
     let rest = "move_south(get_obj(\"tv\"));\nmove_to_object(\"bedroom\");";
-    let (out, reqs) = plan_scripted(&[&first, rest], instruction);
-    assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 1 });
-    let kept = reqs[1].messages.last().unwrap();
-    assert_eq!(kept.role, Role::Assistant);
-    assert!(
-        kept.content.ends_with("#{colour: \"red\"}));\n"),
-        "{}",
-        kept.content
-    );
-    let g = reqs[1].grammar.as_deref().unwrap();
+    let g = held_reask_grammar(&first, rest, instruction, true);
     assert!(g.contains("root ::= firstside \"\\n\" ("), "{g}");
     let first_side = g
         .lines()
@@ -293,13 +302,7 @@ fn a_reask_moves_to_the_side_asked_for_where_the_plan_stopped_at_the_object() {
         .unwrap_or_default();
     assert!(first_side.contains("move_south("), "{g}");
     // `--reask-stop-anywhere`: no such hold.
-    let map = flat_a();
-    let robot = SimRobot::new(map.clone());
-    let b = Scripted::new(&[&first, rest]);
-    let mut ctx = v2(&map, &robot);
-    ctx.options.reask_stops_first = false;
-    plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
-    let g = b.requests()[1].grammar.clone().unwrap();
+    let g = held_reask_grammar(&first, rest, instruction, false);
     assert!(!g.contains("firstside"), "{g}");
 }
 
@@ -315,16 +318,7 @@ fn a_reask_stops_between_the_two_where_the_plan_stopped_at_one() {
     let first = format!("{objects}move_to_object(get_obj(\"sofa\", #{{colour: \"red\"}}));\nmove_to_object(get_obj(\"table\", #{{colour: \"yellow\"}}));\nmove_to_object(\"bedroom\");\n");
     let rest =
         "move_between_the_two(\"table\", #{colour: \"yellow\"});\nmove_to_object(\"bedroom\");";
-    let (out, reqs) = plan_scripted(&[&first, rest], instruction);
-    assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 1 });
-    let kept = reqs[1].messages.last().unwrap();
-    assert_eq!(kept.role, Role::Assistant);
-    assert!(
-        kept.content.ends_with("#{colour: \"red\"}));\n"),
-        "{}",
-        kept.content
-    );
-    let g = reqs[1].grammar.as_deref().unwrap();
+    let g = held_reask_grammar(&first, rest, instruction, true);
     assert!(g.contains("root ::= firstside \"\\n\" ("), "{g}");
     assert!(g.contains("move_between_the_two("), "{g}");
     // Written as a stop at each table: the one stop between them stands for both, so
@@ -336,13 +330,7 @@ fn a_reask_stops_between_the_two_where_the_plan_stopped_at_one() {
     assert!(g.contains("root ::= firstside \"\\n\" ("), "{g}");
     assert!(g.contains("stmtn (\"\\n\" stmtn){0,15}"), "{g}");
     // `--reask-stop-anywhere`: no such hold.
-    let map = flat_a();
-    let robot = SimRobot::new(map.clone());
-    let b = Scripted::new(&[&first, rest]);
-    let mut ctx = v2(&map, &robot);
-    ctx.options.reask_stops_first = false;
-    plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
-    let g = b.requests()[1].grammar.clone().unwrap();
+    let g = held_reask_grammar(&first, rest, instruction, false);
     assert!(!g.contains("firstside"), "{g}");
 }
 
