@@ -281,8 +281,9 @@ pub fn disputed_places(
     // no stop the plan's steps stand for ([`start_room_named_first`]). Held-out v15
     // (dev) rc04: counted as the first thing named, no step stood for it, so the re-ask
     // for "..., and finish in the parts store" kept no step and lost the plan.
-    let here = start_room_named_first(map, &words(instruction), pose);
-    let mentions: Vec<String> = name_mentions(map, &words(instruction), pose)
+    let w = words(instruction);
+    let here = start_room_named_first(map, &w, pose);
+    let mentions: Vec<String> = name_mentions(map, &w, pose)
         .into_iter()
         .map(|(_, l)| l)
         .skip(usize::from(here.is_some()))
@@ -652,13 +653,12 @@ fn check_tuples(
                 .iter()
                 .any(|o| matches!(o, planner_dsl::typed::Object::Instance(_)))
     });
-    let mut used = plan_labels(map, plan, pose);
-    used.extend(start_room_named_first(map, &words(instruction), pose));
+    let accounts = Accounts::new(map, instruction, plan, pose);
     // An empty objects line for a plan that picks what the person named.
     if tuples.is_empty() {
         let named: Vec<String> = said_names(map, &words(instruction))
             .into_iter()
-            .filter(|(_, label)| used.contains(label))
+            .filter(|(_, label)| accounts.used.contains(label))
             .map(|(said, _)| said)
             .collect();
         if !named.is_empty() {
@@ -678,7 +678,6 @@ fn check_tuples(
     let known = colours_of(map, refs);
     let colour_is_said = colour_said(instruction, &known);
     let named = named_labels(map, &w, pose);
-    let said_of = regions_said_of(map, instruction, pose);
     // A colour said only right before other objects' names ("the crate next to the blue
     // cabinet": blue, of the cabinet) is not said of a tuple's object: a tuple giving it
     // one is the model's note, and the plan is judged on its own (held-out v7, dev,
@@ -763,16 +762,18 @@ fn check_tuples(
             let said_of_it = mentions.iter().any(|(x, l, excluded)| {
                 !excluded && *x == canonical(c) && l.as_deref() == Some(label.as_str())
             });
-            let of_label = picks(map, pose, &label);
-            let carried = targets(plan)
-                .iter()
-                .any(|t| of_label(t) && same_colour(t.colour.as_deref(), c));
+            let carried = || {
+                let of_label = picks(map, pose, &label);
+                targets(plan)
+                    .iter()
+                    .any(|t| of_label(t) && same_colour(t.colour.as_deref(), c))
+            };
             if !region
-                && (said_of_it || carried)
                 && !map
                     .instances
                     .iter()
                     .any(|i| i.label == label && same_colour(i.colour.as_deref(), c))
+                && (said_of_it || carried())
             {
                 out.push(Finding::new(
                     FindingKind::NotOnMap,
@@ -788,14 +789,7 @@ fn check_tuples(
                 continue;
             }
         }
-        if !accounted_for(
-            map,
-            &label,
-            &used,
-            visited,
-            &said_of,
-            by_reference.then_some(refs),
-        ) {
+        if !accounts.has(map, &label, visited, by_reference.then_some(refs)) {
             let f = Finding::new(
                 FindingKind::Parts,
                 format!(
@@ -832,40 +826,53 @@ fn named_labels(map: &IvlMap, w: &[String], pose: Pose) -> Vec<String> {
     out
 }
 
-/// Whether the plan accounts for `label`: it names it (`used`), its dry run reached one
-/// or, for a region, an object in it that the region is said of (`visited`, `said_of`:
-/// [`regions_said_of`]), or, where the plan can reach earlier stops (`refs`: the
-/// conversation's instances, when the plan moves by id or position), the conversation
-/// visited one.
-fn accounted_for(
-    map: &IvlMap,
-    label: &str,
-    used: &[String],
-    visited: &[u32],
-    said_of: &[(String, Vec<String>)],
-    refs: Option<&[u32]>,
-) -> bool {
-    let is = |id: &u32| map.instance_by_id(*id).is_some_and(|i| i.label == label);
-    // A region is accounted for when the plan stops at an object in it that the person
-    // placed there ("the yellow table in the kitchen" on a map whose one yellow table is
-    // there). A stop at some other object that happens to stand in it is not a visit to
-    // the room: held-out v15 (dev) rc02, "the second axle stand, then any parts shelf
-    // except the yellow one, and end up back in the engine shed", left the shed out, and
-    // the axle stand in the shed hid it from both checks.
-    let inside = |id: &u32| {
-        map.instance_by_id(*id).is_some_and(|i| {
-            said_of
-                .iter()
-                .any(|(l, rs)| *l == i.label && rs.iter().any(|r| r == label))
-                && map
-                    .regions
+/// What a plan accounts for of the names the person said ([`Accounts::has`]): the
+/// names it uses ([`plan_labels`], with the room the robot is in where it is named first,
+/// [`start_room_named_first`]) and the regions said of each object
+/// ([`regions_said_of`]). Read once per answer by [`check_tuples`] and [`check_names`].
+struct Accounts {
+    used: Vec<String>,
+    said_of: Vec<(String, Vec<String>)>,
+}
+
+impl Accounts {
+    fn new(map: &IvlMap, instruction: &str, plan: &TypedPlan, pose: Pose) -> Self {
+        let mut used = plan_labels(map, plan, pose);
+        used.extend(start_room_named_first(map, &words(instruction), pose));
+        Self {
+            used,
+            said_of: regions_said_of(map, instruction, pose),
+        }
+    }
+
+    /// Whether the plan accounts for `label`: it names it, its dry run reached one or,
+    /// for a region, an object in it that the region is said of (`visited`), or, where
+    /// the plan can reach earlier stops (`refs`: the conversation's instances, when the
+    /// plan moves by id or position), the conversation visited one.
+    fn has(&self, map: &IvlMap, label: &str, visited: &[u32], refs: Option<&[u32]>) -> bool {
+        let is = |id: &u32| map.instance_by_id(*id).is_some_and(|i| i.label == label);
+        // A region is accounted for when the plan stops at an object in it that the
+        // person placed there ("the yellow table in the kitchen" on a map whose one
+        // yellow table is there). A stop at some other object that happens to stand in
+        // it is not a visit to the room: held-out v15 (dev) rc02, "the second axle
+        // stand, then any parts shelf except the yellow one, and end up back in the
+        // engine shed", left the shed out, and the axle stand in the shed hid it from
+        // both checks.
+        let inside = |id: &u32| {
+            map.instance_by_id(*id).is_some_and(|i| {
+                self.said_of
                     .iter()
-                    .any(|r| r.name == label && r.polygon.contains(i.centroid))
-        })
-    };
-    used.iter().any(|u| u == label)
-        || visited.iter().any(|id| is(id) || inside(id))
-        || refs.is_some_and(|r| r.iter().any(is))
+                    .any(|(l, rs)| *l == i.label && rs.iter().any(|r| r == label))
+                    && map
+                        .regions
+                        .iter()
+                        .any(|r| r.name == label && r.polygon.contains(i.centroid))
+            })
+        };
+        self.used.iter().any(|u| u == label)
+            || visited.iter().any(|id| is(id) || inside(id))
+            || refs.is_some_and(|r| r.iter().any(is))
+    }
 }
 
 /// The colours the instruction says of a map object, with that object's label ("the
@@ -1767,22 +1774,13 @@ fn check_names(
     visited: &[u32],
     refs: &[u32],
 ) -> Vec<Finding> {
-    let mut used = plan_labels(map, plan, pose);
-    used.extend(start_room_named_first(map, &words(instruction), pose));
+    let accounts = Accounts::new(map, instruction, plan, pose);
     let by_position = plan.steps.iter().any(|s| matches!(s, Step::MoveTo(_)));
     let w = words(instruction);
-    let said_of = regions_said_of(map, instruction, pose);
     let mut out = Vec::new();
     for (said, label) in said_names(map, &w) {
         // "go back to the sofa you visited" may be a move to where the robot stopped.
-        if !accounted_for(
-            map,
-            &label,
-            &used,
-            visited,
-            &said_of,
-            by_position.then_some(refs),
-        ) {
+        if !accounts.has(map, &label, visited, by_position.then_some(refs)) {
             // A room is not picked with get_obj (the grammar offers only object names
             // there): measured on held-out v2 (dev), asked to pick "the restroom" with
             // get_obj, the default model wrote get_obj("refrigerator").
