@@ -1118,6 +1118,22 @@ fn noun_before(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<Strin
     noun_before_at(map, w, i, pose).map(|(_, l)| l)
 }
 
+/// The map object a superlative at `i` ("farthest") is said of: named right before it
+/// ("the desk farthest from you"), else right after it past colour words and one word
+/// more ([`count_noun`]: "the farthest red desk", "the second farthest desk"), else the
+/// last one named before it in its clause, up to six words back ("the bucket that's
+/// second from farthest"); a clause ends at "then" and "and". Its label.
+fn superlative_noun(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<String> {
+    noun_before(map, w, i, pose)
+        .or_else(|| count_noun(map, w, i, pose).map(|(_, l)| l))
+        .or_else(|| {
+            (i.saturating_sub(6)..i)
+                .rev()
+                .take_while(|&j| !matches!(w[j].as_str(), "then" | "and"))
+                .find_map(|j| noun_before(map, w, j, pose))
+        })
+}
+
 /// [`noun_before`] with the words of the name: the words, and the label.
 fn noun_before_at(map: &IvlMap, w: &[String], i: usize, pose: Pose) -> Option<(String, String)> {
     let mut candidates = Vec::new();
@@ -1274,18 +1290,46 @@ fn check_words(
                 continue;
             }
             // From the far end: the last nearest-first, or the first farthest-first.
-            // ordinal -1 in far_to_near is the nearest.
-            if !any_target(&|t| from_end(t, ObjectOrder::FarToNear)) {
+            // ordinal -1 in far_to_near is the nearest. On the object it is said of
+            // ([`superlative_noun`]), where the plan picks that object; and after "from"
+            // it names the end a count starts at ("the bucket that's second from
+            // farthest": 2 far-to-near, as "from the westernmost" below). Held-out v16
+            // (dev) vb04: `#{ordinal: 2}` (the second nearest) passed because another
+            // object of the plan was counted far to near.
+            let of_noun =
+                said_and_picked(map, pose, superlative_noun(map, &w, i, pose), &any_target);
+            let on_noun = on_said(map, pose, of_noun.as_deref());
+            let count = from_before(&w, i)
+                .and_then(|f| f.checked_sub(1))
+                .and_then(|j| said_count(&w[j]).filter(|&k| k > 1).map(|k| (j, k)));
+            if let Some((j, k)) = count {
+                if !any_target(&|t| on_noun(t) && counts_from(t, ObjectOrder::FarToNear, k)) {
+                    let said = w[j..=i].join(" ");
+                    out.push(
+                        Finding::new(
+                            FindingKind::Word,
+                            format!("the person said \"{said}\", but no object in the plan is counted so: that is ordinal: {k} with order \"far_to_near\" (or ordinal: -{k} alone)"),
+                            format!("which one is the {said}?"),
+                        )
+                        .about_label(of_noun.clone()),
+                    );
+                }
+                continue;
+            }
+            if !any_target(&|t| on_noun(t) && from_end(t, ObjectOrder::FarToNear)) {
                 let to_model = if any_target(&|t| t.order == ObjectOrder::FarToNear) {
                     format!("the person said \"{word}\", but ordinal -1 in order \"far_to_near\" is the nearest: for the {word} write ordinal: -1 alone (or ordinal: 1 with order \"far_to_near\")")
                 } else {
                     format!("the person said \"{word}\", but no object in the plan is counted from that end (ordinal -1, or an order)")
                 };
-                out.push(Finding::new(
-                    FindingKind::Word,
-                    to_model,
-                    format!("which one is the {word}?"),
-                ));
+                out.push(
+                    Finding::new(
+                        FindingKind::Word,
+                        to_model,
+                        format!("which one is the {word}?"),
+                    )
+                    .about_label(of_noun.clone()),
+                );
             }
             continue;
         }
@@ -1320,8 +1364,7 @@ fn check_words(
                 // read as "the westernmost" (ordinal 1), a right first answer
                 // (`#{ordinal: 2, order: "west_to_east"}`) was re-asked, and the re-asks
                 // ended in a refusal.
-                let from = prev == "from" || (prev == "the" && i >= 2 && w[i - 2] == "from");
-                if from {
+                if from_before(&w, i).is_some() {
                     if !any_target(&|t| on_noun(t) && from_end(t, o)) {
                         out.push(
                             Finding::new(
@@ -1469,6 +1512,18 @@ fn check_words(
         }
     }
     out
+}
+
+/// Where "from" is said right before `w[i]`, or before "the" right before it ("second
+/// from farthest", "counting from the westernmost one"): the word then names the end a
+/// count starts at.
+fn from_before(w: &[String], i: usize) -> Option<usize> {
+    let at = |j: usize| w.get(j).map(String::as_str);
+    match at(i.checked_sub(1)?)? {
+        "from" => Some(i - 1),
+        "the" if at(i.checked_sub(2)?) == Some("from") => Some(i - 2),
+        _ => None,
+    }
 }
 
 /// How many words before "from the west" its count may be said ("the second to last
@@ -2071,8 +2126,23 @@ pub(crate) fn return_said_on(map: &IvlMap, instruction: &str, pose: Pose, in_cha
                 .is_some_and(|p| matches!(c[p].as_str(), "the" | "a" | "its" | "their"))
         };
         let names_after = |i: usize| spans.iter().any(|&(a, _)| a > i);
+        // "come over to me again", "finish next to me": the person, who stands where
+        // the robot began (design.md's "come back here" said of the speaker). Held-out
+        // v16 (dev) va01: "once ur done come over to me again" was read as no return.
+        // Only in a clause that names nothing of the map: "the sofa next to me" names
+        // the sofa.
+        let to_me = |i: usize| {
+            c[i] == "me"
+                && spans.is_empty()
+                && i.checked_sub(1).is_some_and(|p| {
+                    matches!(
+                        c[p].as_str(),
+                        "to" | "by" | "beside" | "near" | "towards" | "toward"
+                    )
+                })
+        };
         c.iter().enumerate().any(|(i, w)| {
-            matches!(w.as_str(), "back" | "return" | "returning" | "home")
+            (matches!(w.as_str(), "back" | "return" | "returning" | "home") || to_me(i))
                 && !in_name(i)
                 && !a_noun(i)
                 && !names_after(i)
@@ -5978,6 +6048,66 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn the_far_end_is_looked_for_on_the_object_it_is_said_of() {
+        // Held-out v16 (dev) vb04's shape: the count from the far end written nearest
+        // first, and another object counted far to near.
+        let plan = |chair: &str| {
+            format!("objects: [(chair, 2, None), (sofa, 1, None, far_to_near)]\nplan:\nmove_to_object(get_obj(\"chair\", {chair}));\nmove_to_object(get_obj(\"sofa\", #{{ordinal: 1, order: \"far_to_near\"}}));")
+        };
+        let said = "go to the chair that's second from farthest, then the sofa furthest from you";
+        let f = findings(said, &plan("#{ordinal: 2}"));
+        let x = f
+            .iter()
+            .find(|x| x.to_model.contains("the person said \"second from farthest\", but no object in the plan is counted so: that is ordinal: 2 with order \"far_to_near\""))
+            .unwrap_or_else(|| panic!("{f:?}"));
+        assert_eq!(x.about, Some(About::Label("chair".to_string())));
+        assert_eq!(x.to_user, "which one is the second from farthest?");
+        for right in [
+            "#{ordinal: 2, order: \"far_to_near\"}",
+            "#{ordinal: -2}",
+            "#{ordinal: -2, order: \"near_to_far\"}",
+        ] {
+            let f = findings(said, &plan(right));
+            assert!(
+                f.iter().all(|x| !x.to_model.contains("farthest")),
+                "{right}: {f:?}"
+            );
+        }
+        // "from the farthest" says the same; the farthest alone is looked for on the
+        // chair too, whichever side of it the chair is named.
+        let f = findings(
+            "the second from the farthest chair, then the sofa furthest from you",
+            &plan("#{ordinal: 2}"),
+        );
+        assert!(
+            f.iter()
+                .any(|x| x.to_model.contains("\"second from the farthest\"")),
+            "{f:?}"
+        );
+        for said in [
+            "the farthest chair, then the sofa furthest from you",
+            "the chair farthest from you, then the sofa furthest from you",
+        ] {
+            let f = findings(said, &plan("#{ordinal: 1}"));
+            let x = f
+                .iter()
+                .find(|x| {
+                    x.to_model
+                        .contains("no object in the plan is counted from that end")
+                        || x.to_model
+                            .contains("ordinal -1 in order \"far_to_near\" is the nearest")
+                })
+                .unwrap_or_else(|| panic!("{said}: {f:?}"));
+            assert_eq!(x.about, Some(About::Label("chair".to_string())), "{said}");
+            let f = findings(said, &plan("#{ordinal: -1}"));
+            assert!(
+                f.iter().all(|x| !x.to_model.contains("farthest")),
+                "{said}: {f:?}"
+            );
+        }
+    }
+
+    #[test]
     fn a_count_in_a_direction_said_of_another_object_is_a_finding() {
         let says = "but the person named a direction only for the table";
         let instruction = "the penultimate chair first, then the 2nd table counting from the west";
@@ -7083,6 +7213,9 @@ pub(crate) mod tests {
             "then back to square one",
             // What return_said reads, the map or not.
             "go to the sofa and come back here",
+            "the sofa, and once ur done come over to me again",
+            "the sofa, then finish next to me",
+            "the fridge, then swing by me",
         ] {
             assert!(return_said_on(&m, yes, pose, false), "{yes}");
         }
@@ -7096,6 +7229,9 @@ pub(crate) mod tests {
             "go back three metres",
             "go back to the one you saw",
             "go to the sofa",
+            "tell me when you reach the sofa",
+            "go to the sofa next to me",
+            "come to me at the fridge",
         ] {
             assert!(!return_said_on(&m, no, pose, false), "{no}");
         }
