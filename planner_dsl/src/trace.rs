@@ -50,6 +50,21 @@ impl RunOutcome {
     pub fn is_ok(&self) -> bool {
         self.error.is_none()
     }
+
+    /// The instances the plan's selections picked, in call order, once each: every
+    /// object a library call returned (`get_obj(...)`, an anchor of `near:` included),
+    /// whether or not the robot then stopped at it.
+    pub fn selected(&self) -> Vec<u32> {
+        let mut out = Vec::new();
+        for e in &self.trace {
+            if let Ok(r) = serde_json::from_value::<crate::value::ObjectRecord>(e.result.clone()) {
+                if !out.contains(&r.id) {
+                    out.push(r.id);
+                }
+            }
+        }
+        out
+    }
 }
 
 /// A dry run's result: the outcome and the preview trajectory of the robot's copy.

@@ -109,6 +109,28 @@ fn dry_run_previews_without_moving_the_real_robot() {
 }
 
 #[test]
+fn a_run_lists_the_instances_its_selections_picked() {
+    let (map, robot) = world("flat-a");
+    // The anchor of `near` is picked, though no stop is made at it.
+    let plan = Plan::compile(
+        "agent.move_to_object(agent.get_obj(\"chair\", #{near: agent.get_obj(\"sofa\", #{colour: \"red\"})}));\nagent.move_to_object(agent.get_obj(\"fridge\"));\nagent.move_to_object(agent.get_obj(\"fridge\"));",
+    )
+    .unwrap();
+    let preview = dry_run(&plan, &map, &robot, &Limits::default());
+    assert!(preview.outcome.is_ok(), "{:?}", preview.outcome.error);
+    let picked = preview.outcome.selected();
+    let named: Vec<(String, Option<String>)> = picked
+        .iter()
+        .filter_map(|id| map.instance_by_id(*id))
+        .map(|i| (i.label.clone(), i.colour.clone()))
+        .collect();
+    let labels: Vec<&str> = named.iter().map(|(l, _)| l.as_str()).collect();
+    assert_eq!(labels, ["sofa", "chair", "fridge"], "{picked:?}");
+    assert_eq!(named[0].1.as_deref(), Some("red"));
+    assert_eq!(preview.trajectory.stops.len(), 3);
+}
+
+#[test]
 fn trace_records_calls_and_round_trips_through_json() {
     let (map, mut robot) = world("flat-a");
     let plan = Plan::compile(

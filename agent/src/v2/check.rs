@@ -1175,13 +1175,16 @@ fn plan_instances(plan: &TypedPlan) -> Vec<u32> {
         .collect()
 }
 
-/// The instruction's words against the plan's targets.
+/// The instruction's words against the plan's targets. `visited`: the instances the dry
+/// run stopped at; `picked`: every instance its selections picked, anchors included
+/// ([`planner_dsl::RunOutcome::selected`]).
 fn check_words(
     map: &IvlMap,
     instruction: &str,
     plan: &TypedPlan,
     pose: Pose,
     visited: &[u32],
+    picked: &[u32],
 ) -> Vec<Finding> {
     let ts = targets(plan);
     let any_target = |f: &dyn Fn(&Target) -> bool| ts.iter().any(|t| f(t));
@@ -1208,16 +1211,30 @@ fn check_words(
                     .instances
                     .iter()
                     .any(|i| visited.contains(&i.id) && same_colour(i.colour.as_deref(), &c));
+                // Name the object it is said of, when the words say ("the second
+                // black chair"): the re-ask then points at one selection.
+                let of = colour_noun(map, &w, i, pose);
+                // Or the plan picks one of that colour of the object it is said of, where
+                // it makes no stop ("the saddle display next to the green frame jig" as
+                // `near: get_obj("frame jig")`, on a map whose frame jig there is the
+                // green one): what the plan does is what was asked. Held-out v16 (dev)
+                // va05: that right first answer was re-asked.
+                let picked_of = |label: &str| {
+                    map.instances.iter().any(|i| {
+                        picked.contains(&i.id)
+                            && i.label == label
+                            && same_colour(i.colour.as_deref(), &c)
+                    })
+                };
+                let picked_here = of.as_ref().is_some_and(|(_, l)| picked_of(l));
                 if !repeated
                     && !reached
+                    && !picked_here
                     && !any_target(&|t| {
                         same_colour(t.colour.as_deref(), &c)
                             || same_colour(t.not_colour.as_deref(), &c)
                     })
                 {
-                    // Name the object it is said of, when the words say ("the second
-                    // black chair"): the re-ask then points at one selection.
-                    let of = colour_noun(map, &w, i, pose);
                     let to_model = match &of {
                         Some((noun, label)) => format!(
                             "the person said \"{word} {noun}\", but no {label} in the plan has colour \"{c}\": write colour: \"{c}\" in that {label}'s selection"
@@ -1256,7 +1273,9 @@ fn check_words(
                                 || (negated && same_colour(t.not_colour.as_deref(), &c)))
                     });
                     let reached_here = map.instances.iter().any(|i| {
-                        (visited.contains(&i.id) || plan_instances(plan).contains(&i.id))
+                        (visited.contains(&i.id)
+                            || picked.contains(&i.id)
+                            || plan_instances(plan).contains(&i.id))
                             && i.label == label
                             && same_colour(i.colour.as_deref(), &c)
                     });
@@ -4299,11 +4318,23 @@ pub fn check_answer(
     visited: &[u32],
     refs: &[u32],
 ) -> Vec<Finding> {
-    check_answer_after(map, instruction, None, tuples, plan, pose, visited, refs)
+    check_answer_after(
+        map,
+        instruction,
+        None,
+        tuples,
+        plan,
+        pose,
+        visited,
+        visited,
+        refs,
+    )
 }
 
 /// [`check_answer`] for an instruction that may answer an `earlier` one, which got a
-/// question or a refusal instead of a plan (`PlanContext::earlier`): the earlier words
+/// question or a refusal instead of a plan (`PlanContext::earlier`), with the instances
+/// the dry run's selections picked (`picked`; [`check_answer`] takes those it stopped
+/// at): the earlier words
 /// count as said for what a plan may select on (colours, counts, orders, rooms), never
 /// as asked for, so what the person asks is still read from `instruction` alone.
 #[must_use]
@@ -4316,11 +4347,12 @@ pub fn check_answer_after(
     plan: &TypedPlan,
     pose: Pose,
     visited: &[u32],
+    picked: &[u32],
     refs: &[u32],
 ) -> Vec<Finding> {
     let mut out = check_tuples(map, instruction, tuples, plan, pose, visited, refs);
     out.extend(check_names(map, instruction, plan, pose, visited, refs));
-    out.extend(check_words(map, instruction, plan, pose, visited));
+    out.extend(check_words(map, instruction, plan, pose, visited, picked));
     out.extend(check_two_guessed(map, instruction, plan, pose));
     out.extend(check_visits(map, instruction, pose, visited, refs));
     out.extend(check_anchor_stops(map, instruction, plan, pose));
@@ -5119,6 +5151,7 @@ pub(crate) mod tests {
             &a.tuples,
             &a.plan,
             m.start_pose,
+            &[],
             &[],
             &[],
         )
@@ -6058,6 +6091,45 @@ pub(crate) mod tests {
         assert_eq!(sofa.about, Some(About::Step(1)), "the sofa's step");
         assert!(
             f.iter().all(|x| !x.to_model.contains("picks the chair")),
+            "{f:?}"
+        );
+    }
+
+    #[test]
+    fn a_colour_the_plan_picks_where_it_makes_no_stop_is_carried() {
+        // Held-out v16 (dev) va05's shape: the anchor's colour left out, where the
+        // anchor the plan picks is of that colour anyway.
+        let m = map();
+        let colour_findings = |instruction: &str, answer: &str, picked: &[u32]| {
+            let a = parse_answer(answer).unwrap();
+            check_answer_after(
+                &m,
+                instruction,
+                None,
+                &a.tuples,
+                &a.plan,
+                m.start_pose,
+                &[],
+                picked,
+                &[],
+            )
+            .into_iter()
+            .filter(|x| x.to_model.contains("in the plan has colour"))
+            .collect::<Vec<_>>()
+        };
+        let near = "objects: [(chair, None, None), (sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"chair\", #{near: get_obj(\"sofa\")}));";
+        let said = "go to the chair next to the red sofa";
+        // Sofa 1 is the red one, 2 the black one; chair 7 is grey.
+        assert!(colour_findings(said, near, &[1, 7]).is_empty());
+        let f = colour_findings(said, near, &[2, 7]);
+        assert!(
+            f.iter().any(|x| x.to_model.contains("\"red sofa\"")),
+            "{f:?}"
+        );
+        // A red object of another name picked is not the red chair said.
+        let f = colour_findings("go to the red chair next to the sofa", near, &[1, 7]);
+        assert!(
+            f.iter().any(|x| x.to_model.contains("\"red chair\"")),
             "{f:?}"
         );
     }

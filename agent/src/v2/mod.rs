@@ -318,10 +318,12 @@ fn assess(
     let plan = Plan::compile(&script)
         .map_err(|e| unreadable(format!("the plan does not compile: {e}")))?;
     let mut visited = Vec::new();
+    let mut picked = Vec::new();
     let mut run_error = None;
     if ctx.options.dry_run {
         if let Some(robot) = ctx.robot {
             let d = planner_dsl::dry_run(&plan, ctx.map, robot, &Limits::default());
+            picked = d.outcome.selected();
             for s in &d.trajectory.stops {
                 match s.target {
                     StopTarget::Instance(i) => visited.push(i),
@@ -348,6 +350,7 @@ fn assess(
         &answer.plan,
         pose,
         &visited,
+        &picked,
         &ctx.references,
     );
     if ctx.options.said_only
