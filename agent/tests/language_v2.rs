@@ -1041,7 +1041,7 @@ fn chat_references_count_the_visits_and_a_revisit_for_the_other_one_is_reasked()
 }
 
 #[test]
-fn with_regions_of_said_a_room_said_of_another_object_is_reasked() {
+fn a_room_said_of_another_object_is_reasked() {
     let said =
         "the table closest to the red sofa. Then the third chair, and then into the dining room";
     let answer = |table_region: &str| {
@@ -1050,8 +1050,8 @@ fn with_regions_of_said_a_room_said_of_another_object_is_reasked() {
         )
     };
     let (wrong, right) = (answer("region: \"dining room\", "), answer(""));
-    let on = |o: &mut PlanOptions| o.regions_of_said = true;
-    let (out, reqs) = plan_scripted_opts(&[&wrong, &right], said, on);
+    // The default since stop 81 (`PlanOptions::regions_of_said`).
+    let (out, reqs) = plan_scripted(&[&wrong, &right], said);
     assert!(out.plan().is_some(), "{out:?}");
     assert_eq!(reqs.len(), 2, "one re-ask");
     let last = &reqs[1].messages.last().unwrap().content;
@@ -1060,11 +1060,12 @@ fn with_regions_of_said_a_room_said_of_another_object_is_reasked() {
         "{last}"
     );
     // The right answer stands at once.
-    let (out, reqs) = plan_scripted_opts(&[&right], said, on);
+    let (out, reqs) = plan_scripted(&[&right], said);
     assert!(out.plan().is_some(), "{out:?}");
     assert_eq!(reqs.len(), 1);
-    // Off (the default): the answer is not judged on it.
-    let (out, reqs) = plan_scripted(&[&wrong], said);
+    // Off (`--regions-anywhere`): the answer is not judged on it.
+    let off = |o: &mut PlanOptions| o.regions_of_said = false;
+    let (out, reqs) = plan_scripted_opts(&[&wrong], said, off);
     assert!(out.plan().is_some(), "{out:?}");
     assert_eq!(reqs.len(), 1);
 }

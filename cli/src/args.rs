@@ -285,10 +285,14 @@ pub(crate) struct ModelArgs {
     #[arg(long)]
     pub(crate) directions_anywhere: bool,
     /// Let a pick select in a room (`region:`) only where the instruction says that room
-    /// of its object, in the clause naming it or one next to it naming no object (off
-    /// by default until judged).
-    #[arg(long)]
+    /// of its object, in the clause naming it or one next to it naming no object. The
+    /// default since stop 81; the flag is kept so that earlier commands still run.
+    #[arg(long, conflicts_with = "regions_anywhere")]
     pub(crate) regions_of_said: bool,
+    /// Let a pick select in any room the instruction names, said of it or not (the
+    /// default before stop 81; for comparison; the checks then re-ask an unsaid one).
+    #[arg(long)]
+    pub(crate) regions_anywhere: bool,
     /// Let a pick of any object count two or more wherever the instruction says such a
     /// count, not only one whose clause says it (the default before stop 64; for
     /// comparison).
@@ -432,7 +436,7 @@ impl ModelArgs {
             said_colours: self.said_colours || !self.unsaid_colours_allowed,
             said_exclusions: !self.any_not_colours,
             directions_of_said: !self.directions_anywhere,
-            regions_of_said: self.regions_of_said,
+            regions_of_said: self.regions_of_said || !self.regions_anywhere,
             counts_of_said: !self.counts_anywhere,
             far_ends_of_said: !self.far_end_anywhere,
             side_stops_of_said: self.side_stops_barred,

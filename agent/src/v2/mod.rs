@@ -638,8 +638,8 @@ fn narrow_said_of(
 /// Offers a pick of each name only the regions said of its object
 /// ([`check::regions_said_of`]: in the clause naming it, or in a clause naming no object
 /// next to it), within those [`Vocabulary::regions_of`] already gives it; a name said of
-/// no region takes no `region` key (`PlanOptions::regions_of_said`, off by default until
-/// judged). Its check is [`check::check_regions_of_others`], in [`assess`]. Held-out
+/// no region takes no `region` key (`PlanOptions::regions_of_said`, on by default since
+/// stop 81). Its check is [`check::check_regions_of_others`], in [`assess`]. Held-out
 /// v10 (dev) ka05: "the wheelchair closest to the blue hospital bed. Then the
 /// westernmost stretcher, and then into triage" picked the wheelchair in triage.
 fn narrow_regions_of_said(
@@ -2855,7 +2855,7 @@ mod tests {
         // chairs: the room said after the chair is not the table's.
         let said = "the table closest to the red sofa. Then the third chair, and then into the dining room";
         grammar::tests::assert_offers(
-            &narrowed_grammar_with(said, |o| o.regions_of_said = true),
+            &narrowed_grammar(said),
             one_pick,
             &[
                 r#""chair", #{ordinal: 3, region: "dining room"}"#,
@@ -2866,9 +2866,10 @@ mod tests {
                 r#""sofa", #{region: "dining room"}"#,
             ],
         );
-        // Off (the default until judged): any pick may take the room said.
+        // Off (`--regions-anywhere`, the default before stop 81): any pick may take the
+        // room said.
         grammar::tests::assert_offers(
-            &narrowed_grammar(said),
+            &narrowed_grammar_with(said, |o| o.regions_of_said = false),
             one_pick,
             &[r#""table", #{region: "dining room"}"#],
             &[],
