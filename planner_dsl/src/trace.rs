@@ -57,7 +57,7 @@ impl RunOutcome {
     pub fn selected(&self) -> Vec<u32> {
         let mut out = Vec::new();
         for e in &self.trace {
-            if let Ok(r) = serde_json::from_value::<crate::value::ObjectRecord>(e.result.clone()) {
+            if let Ok(r) = crate::value::ObjectRecord::deserialize(&e.result) {
                 if !out.contains(&r.id) {
                     out.push(r.id);
                 }

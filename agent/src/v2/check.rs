@@ -1252,15 +1252,17 @@ fn check_words(
                         None => format!("what is {word}? {}", describe_colour(map, &c, word)),
                     };
                     let mut f = Finding::new(FindingKind::Word, to_model, to_user);
-                    if let Some((_, label)) = of {
-                        f = f.barring(Bar::ColourDropped { label });
+                    if let Some((_, label)) = &of {
+                        f = f.barring(Bar::ColourDropped {
+                            label: label.clone(),
+                        });
                     }
                     out.push(f);
                     continue;
                 }
                 // The colour on the object it is said of: "the chair next to the black
                 // table" is a black table, not a black chair.
-                if let Some((noun, label)) = colour_noun(map, &w, i, pose) {
+                if let Some((noun, label)) = of {
                     let of_label = picks(map, pose, &label);
                     // Excluded only where a word before says so ("not the red chair",
                     // "other than the red chair"): "the yellow table furthest from you"
