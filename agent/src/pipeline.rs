@@ -114,6 +114,11 @@ pub struct PlanOptions {
     /// sets' 31 tasks that had a room in a plan: 28/31 against 24/31;
     /// `--regions-anywhere` turns it off).
     pub regions_of_said: bool,
+    /// With `said_only`, outside a conversation: a pick (`get_obj`, a `near:` anchor, a
+    /// pair) may name only the objects the instruction names (a name, a synonym, a typo
+    /// of one: what `check_unnamed_stops` accepts), where it names any (default on since
+    /// stop 82; `--names-anywhere` turns it off).
+    pub names_of_said: bool,
     /// With `said_only`, outside a conversation: a pick may count two or more (either
     /// end) only where the person said a count of its object, in the clause naming it
     /// (default on; `--counts-anywhere` turns it off).
@@ -256,6 +261,7 @@ impl Default for PlanOptions {
             said_exclusions: true,
             directions_of_said: true,
             regions_of_said: true,
+            names_of_said: true,
             counts_of_said: true,
             far_ends_of_said: true,
             side_stops_of_said: false,

@@ -293,6 +293,11 @@ pub(crate) struct ModelArgs {
     /// default before stop 81; for comparison; the checks then re-ask an unsaid one).
     #[arg(long)]
     pub(crate) regions_anywhere: bool,
+    /// Let a pick name any object of the map, named in the instruction or not (the
+    /// default before stop 82; for comparison; the checks then re-ask a pick of an
+    /// object nobody named).
+    #[arg(long)]
+    pub(crate) names_anywhere: bool,
     /// Let a pick of any object count two or more wherever the instruction says such a
     /// count, not only one whose clause says it (the default before stop 64; for
     /// comparison).
@@ -437,6 +442,7 @@ impl ModelArgs {
             said_exclusions: !self.any_not_colours,
             directions_of_said: !self.directions_anywhere,
             regions_of_said: self.regions_of_said || !self.regions_anywhere,
+            names_of_said: !self.names_anywhere,
             counts_of_said: !self.counts_anywhere,
             far_ends_of_said: !self.far_end_anywhere,
             side_stops_of_said: self.side_stops_barred,

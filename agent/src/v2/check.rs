@@ -851,7 +851,7 @@ fn check_tuples(
 /// letters or more that is not a colour, a typo ("tabel"). Shorter words are read
 /// exactly: "to" is one edit from "tv", "red" from "bed". Read once per answer, not per
 /// tuple.
-fn named_labels(map: &IvlMap, w: &[String], pose: Pose) -> Vec<String> {
+pub(crate) fn named_labels(map: &IvlMap, w: &[String], pose: Pose) -> Vec<String> {
     let single = w.iter().filter(|x| !is_colour_word(x)).filter_map(|x| {
         if x.chars().count() >= 4 {
             label_of_typed(map, x, pose)
