@@ -521,6 +521,83 @@ fn said_whole_name(said: &[String], label: &str) -> bool {
             .any(|n| ends_in(n))
 }
 
+/// Counts that the person said of an object, not right after "the" or "number" (those
+/// [`check_words`] reads: "the third chair"), that the objects line also gives that
+/// object, where no pick of it in the plan counts so: "the bucket that comes last when
+/// you go from west to east" listed `(bucket, last, None)` and planned
+/// `get_obj("bucket", #{order: "west_to_east"})`, the first from the west (held-out v16,
+/// dev, vb11; no check saw it). The words and the model's own line agree on the count;
+/// the plan is what disagrees. Only in a clause that names that one object
+/// ([`clauses`]), and "last" only where words follow it in its clause ("and the
+/// workroom last" says when, not which).
+fn check_listed_counts_unplanned(
+    map: &IvlMap,
+    instruction: &str,
+    tuples: &[Tuple],
+    plan: &TypedPlan,
+    pose: Pose,
+) -> Vec<Finding> {
+    let mut out: Vec<Finding> = Vec::new();
+    for c in clauses(instruction) {
+        let named = object_mentions(map, &c, pose);
+        let [(_, label)] = named.as_slice() else {
+            continue;
+        };
+        let name_words: Vec<&str> = label.split(' ').collect();
+        for (i, x) in c.iter().enumerate() {
+            let prev = i.checked_sub(1).map_or("", |j| c[j].as_str());
+            if matches!(prev, "the" | "number" | "no" | "#") || name_words.contains(&x.as_str()) {
+                continue;
+            }
+            let ordinal_form =
+                ["st", "nd", "rd", "th"].iter().any(|e| x.ends_with(e)) || x == "second";
+            let k = match x.as_str() {
+                "last" => (i + 1 < c.len()).then_some(-1),
+                _ => parse_ordinal(x)
+                    .ok()
+                    .flatten()
+                    .filter(|_| ordinal_form)
+                    .or_else(|| said_count(x).filter(|&k| k == -2)),
+            };
+            let Some(k) = k.filter(|&k| k != 0 && k != 1) else {
+                continue;
+            };
+            let listed = tuples.iter().any(|t| {
+                t.ordinal == Some(k) && object_label(map, &t.object, pose).as_deref() == Some(label)
+            });
+            let of_label: Vec<&Target> = targets(plan)
+                .into_iter()
+                .filter(|t| picks(map, pose, label)(t))
+                .collect();
+            let counts = |t: &&Target| {
+                if k < 0 {
+                    t.ordinal == k || (t.ordinal == -k && t.order != ObjectOrder::NearToFar)
+                } else {
+                    t.ordinal.abs() == k
+                }
+            };
+            if !listed || of_label.is_empty() || of_label.iter().any(counts) {
+                continue;
+            }
+            let wanted = if k < 0 {
+                format!("{k} (or {} counted from the other end)", -k)
+            } else {
+                k.to_string()
+            };
+            let f = Finding::new(
+                FindingKind::Word,
+                format!("the person said \"{}\", and the objects line counts the {label} {k}, but no {label} in the plan has ordinal {wanted}", c.join(" ")),
+                format!("which {label} is the {x}? there are {}", describe_label(map, label)),
+            )
+            .about_label(Some(label.clone()));
+            if !out.contains(&f) {
+                out.push(f);
+            }
+        }
+    }
+    out
+}
+
 /// The article before `word`: "an" before a vowel ("an ironing board"), else "a".
 fn a_or_an(word: &str) -> &'static str {
     if word.starts_with(['a', 'e', 'i', 'o', 'u']) {
@@ -4445,6 +4522,13 @@ pub fn check_answer_after(
     if refs.is_empty() && earlier.is_none() {
         out.extend(check_unnamed_stops(map, instruction, plan, pose));
         out.extend(check_names_said_again(map, instruction, plan, pose));
+        out.extend(check_listed_counts_unplanned(
+            map,
+            instruction,
+            tuples,
+            plan,
+            pose,
+        ));
         out.extend(check_unsaid_anchors(map, instruction, plan, pose));
         out.extend(check_colours_of_others(map, instruction, plan, pose));
     }
@@ -6561,6 +6645,52 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn a_count_the_words_and_the_objects_line_give_is_one_the_plan_must_write() {
+        let listed = |f: &[Finding]| {
+            f.iter()
+                .filter(|x| x.to_model.contains("the objects line counts the table"))
+                .count()
+        };
+        // Held-out v16 (dev) vb11's form: "last" not after "the".
+        let said = "go to the table that comes last when you go from west to east";
+        let plan = |sel: &str| {
+            format!("objects: [(table, last, None)]\nplan:\nmove_to_object(get_obj(\"table\", #{{{sel}}}));")
+        };
+        assert_eq!(listed(&findings(said, &plan("order: \"west_to_east\""))), 1);
+        for right in [
+            "ordinal: -1, order: \"west_to_east\"",
+            "ordinal: 1, order: \"east_to_west\"",
+        ] {
+            assert_eq!(listed(&findings(said, &plan(right))), 0, "{right}");
+        }
+        // "Which is third", listed 3.
+        let f = findings(
+            "the table which is third from the west",
+            "objects: [(table, 3, None, west_to_east)]\nplan:\nmove_to_object(get_obj(\"table\", #{order: \"west_to_east\"}));",
+        );
+        assert_eq!(listed(&f), 1, "{f:?}");
+        // The line lists no count, "last" says when, or the clause names two objects:
+        // nothing to find here.
+        for (said, line) in [
+            (
+                "go to the table that comes last when you go from west to east",
+                "(table, None, None)",
+            ),
+            ("and the table last", "(table, last, None)"),
+            (
+                "the table that comes last by the sofa",
+                "(table, last, None), (sofa, None, None)",
+            ),
+        ] {
+            let f = findings(
+                said,
+                &format!("objects: [{line}]\nplan:\nmove_to_object(get_obj(\"table\"));"),
+            );
+            assert_eq!(listed(&f), 0, "{said}: {f:?}");
+        }
+    }
+
+    #[test]
     fn two_stops_at_what_one_clause_names_once_each_are_a_finding() {
         // Held-out v16 (dev) va05's form: no `near:`, a stop at each.
         let two = "objects: [(plant, None, None), (tv, None, None)]\nplan:\nmove_to_object(get_obj(\"plant\"));\nmove_to_object(get_obj(\"tv\"));";
@@ -6582,7 +6712,10 @@ pub(crate) mod tests {
         }
         // A side of it is a stop at it too.
         let side = "objects: [(plant, None, None), (tv, None, None)]\nplan:\nmove_to_left(get_obj(\"plant\"));\nmove_to_object(get_obj(\"tv\"));";
-        assert_eq!(anchor(&findings("stop left of the plant by the tv", side)).len(), 1);
+        assert_eq!(
+            anchor(&findings("stop left of the plant by the tv", side)).len(),
+            1
+        );
         // Two clauses, the robot between, far apart, a pair, a name said twice, or a
         // face: the stops may be what was asked.
         for said in [
