@@ -518,6 +518,14 @@ pub fn count_from_the_end_at(w: &[String], i: usize) -> Option<(i64, usize)> {
         // dev, vb08; v14 pa09): the one before the last is the second to last.
         ("before", Some("the"), Some("last" | "final" | "end")) => Some((-2, 3)),
         ("last", Some("but"), Some(_)) => count(i + 2).map(|k| (-(k + 1), 3)),
+        // "one shy of the end", "one short of the final one" (held-out v15, dev, rb09:
+        // "counting the offset presses from the west, go to the one that's one shy of
+        // the end" went to another press): k short of the last is k + 1 from the end.
+        (_, Some("shy" | "short"), Some("of"))
+            if at(i + 3) == Some("the") && matches!(at(i + 4), Some("end" | "last" | "final")) =>
+        {
+            count(i).map(|k| (-(k + 1), 5))
+        }
         (_, Some("to" | "from"), Some("last")) => count(i).filter(|&k| k >= 2).map(|k| (-k, 3)),
         (_, Some("last"), _) => count(i).filter(|&k| k >= 2).map(|k| (-k, 2)),
         _ => None,
@@ -665,6 +673,17 @@ mod tests {
             assert_eq!(at(s), Some((-2, len)), "{s}");
         }
         assert_eq!(at("the last but two chairs"), Some((-3, 3)));
+        // From the word before "shy" or "short".
+        let from = |s: &str| {
+            let w = crate::words::words(s);
+            let i = w.iter().position(|x| x == "shy" || x == "short")?;
+            count_from_the_end_at(&w, i.checked_sub(1)?)
+        };
+        assert_eq!(from("the one that's one shy of the end"), Some((-2, 5)));
+        assert_eq!(from("go to the one short of the final one"), Some((-2, 5)));
+        assert_eq!(from("two short of the last"), Some((-3, 5)));
+        assert_eq!(from("stop short of the end wall"), None);
+        assert_eq!(from("one shy of the door"), None);
         assert_eq!(at("the third from last chair"), Some((-3, 3)));
         // Not counts from the end: "the last chair", "the next chair", "the first to
         // last" (1 is not a count from the end in two words), "the last but the".

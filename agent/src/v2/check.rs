@@ -544,15 +544,22 @@ fn check_listed_counts_unplanned(
             continue;
         };
         let name_words: Vec<&str> = label.split(' ').collect();
-        for (i, x) in c.iter().enumerate() {
+        let mut i = 0;
+        while i < c.len() {
+            let x = &c[i];
             let prev = i.checked_sub(1).map_or("", |j| c[j].as_str());
+            // A count from the end in more words ("one shy of the end").
+            let phrase = crate::tuples::count_from_the_end_at(&c, i);
+            let start = i;
+            i += phrase.map_or(1, |(_, len)| len);
             if matches!(prev, "the" | "number" | "no" | "#") || name_words.contains(&x.as_str()) {
                 continue;
             }
             let ordinal_form =
                 ["st", "nd", "rd", "th"].iter().any(|e| x.ends_with(e)) || x == "second";
-            let k = match x.as_str() {
-                "last" => (i + 1 < c.len()).then_some(-1),
+            let k = match (phrase, x.as_str()) {
+                (Some((k, _)), _) => Some(k),
+                (None, "last") => (start + 1 < c.len()).then_some(-1),
                 _ => parse_ordinal(x)
                     .ok()
                     .flatten()
@@ -562,8 +569,19 @@ fn check_listed_counts_unplanned(
             let Some(k) = k.filter(|&k| k != 0 && k != 1) else {
                 continue;
             };
+            // The line counts from the other end in an order ("(table, 2, None,
+            // east_to_west)" for the second to last from the west), or as said.
+            let from_other_end = |t: &Tuple| {
+                k < 0
+                    && t.ordinal == Some(-k)
+                    && t.order
+                        .as_deref()
+                        .and_then(|o| ObjectOrder::parse(o).ok())
+                        .is_some_and(|o| o != ObjectOrder::NearToFar)
+            };
             let listed = tuples.iter().any(|t| {
-                t.ordinal == Some(k) && object_label(map, &t.object, pose).as_deref() == Some(label)
+                (t.ordinal == Some(k) || from_other_end(t))
+                    && object_label(map, &t.object, pose).as_deref() == Some(label)
             });
             let of_label: Vec<&Target> = targets(plan)
                 .into_iter()
@@ -6667,6 +6685,12 @@ pub(crate) mod tests {
         let f = findings(
             "the table which is third from the west",
             "objects: [(table, 3, None, west_to_east)]\nplan:\nmove_to_object(get_obj(\"table\", #{order: \"west_to_east\"}));",
+        );
+        assert_eq!(listed(&f), 1, "{f:?}");
+        // In more words: "one shy of the end" (held-out v15, dev, rb09's form).
+        let f = findings(
+            "counting the tables from the west, go to the table that's one shy of the end",
+            "objects: [(table, 2, None, east_to_west)]\nplan:\nmove_to_object(get_obj(\"table\", #{ordinal: 2}));",
         );
         assert_eq!(listed(&f), 1, "{f:?}");
         // The line lists no count, "last" says when, or the clause names two objects:
