@@ -521,11 +521,24 @@ pub fn count_from_the_end_at(w: &[String], i: usize) -> Option<(i64, usize)> {
         // "one shy of the end", "one short of the final one" (held-out v15, dev, rb09:
         // "counting the offset presses from the west, go to the one that's one shy of
         // the end" went to another press): k short of the last is k + 1 from the end.
-        (_, Some("shy" | "short"), Some("of"))
+        // "Just short of the last one" (v14, dev, pc09) is one short of it.
+        (first, Some("shy" | "short"), Some("of"))
             if at(i + 3) == Some("the") && matches!(at(i + 4), Some("end" | "last" | "final")) =>
         {
-            count(i).map(|k| (-(k + 1), 5))
+            let k = if first == "just" { Some(1) } else { count(i) };
+            k.map(|k| (-(k + 1), 5))
         }
+        // "The last pottery wheel but one", the name inside (held-out v14, dev, pb09 and
+        // pc04: read as no count, so the grammar let those picks count only 1 or -1):
+        // up to three words of a name between "last" and "but", none joining two requests.
+        ("last", Some(next), _) if next != "but" => (i + 2..=i + 4)
+            .find(|&j| at(j) == Some("but"))
+            .filter(|&j| {
+                w[i + 1..j]
+                    .iter()
+                    .all(|x| !matches!(x.as_str(), "then" | "and" | "next" | "after"))
+            })
+            .and_then(|j| count(j + 1).map(|k| (-(k + 1), j + 2 - i))),
         (_, Some("to" | "from"), Some("last")) => count(i).filter(|&k| k >= 2).map(|k| (-k, 3)),
         (_, Some("last"), _) => count(i).filter(|&k| k >= 2).map(|k| (-k, 2)),
         _ => None,
@@ -682,7 +695,26 @@ mod tests {
         assert_eq!(from("the one that's one shy of the end"), Some((-2, 5)));
         assert_eq!(from("go to the one short of the final one"), Some((-2, 5)));
         assert_eq!(from("two short of the last"), Some((-3, 5)));
+        assert_eq!(
+            from("the guest chair just short of the last one"),
+            Some((-2, 5))
+        );
         assert_eq!(from("stop short of the end wall"), None);
+        let w = crate::words::words("stop at the last pottery wheel but one; next the bench");
+        assert_eq!(count_from_the_end_at(&w, 3), Some((-2, 5)));
+        let w = crate::words::words("the last chair but two");
+        assert_eq!(count_from_the_end_at(&w, 1), Some((-3, 4)));
+        for s in [
+            "the last chair, but the red one",
+            "the last chair then the table but one",
+            "the last big old red chair but one",
+        ] {
+            assert_eq!(
+                count_from_the_end_at(&crate::words::words(s), 1),
+                None,
+                "{s}"
+            );
+        }
         assert_eq!(from("one shy of the door"), None);
         assert_eq!(at("the third from last chair"), Some((-3, 3)));
         // Not counts from the end: "the last chair", "the next chair", "the first to

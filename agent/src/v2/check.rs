@@ -1628,6 +1628,10 @@ fn check_words(
                 };
                 let noun = match &before {
                     Some(l) => Some((l.clone(), l.clone())),
+                    // "The last pottery wheel but one": the name is inside the words.
+                    None if word.starts_with("last ") && !word.starts_with("last but") => {
+                        count_noun(map, &w, i, pose)
+                    }
                     None => count_noun(map, &w, at, pose),
                 };
                 if !any_target(&counts) {
@@ -6712,6 +6716,28 @@ pub(crate) mod tests {
             );
             assert_eq!(listed(&f), 0, "{said}: {f:?}");
         }
+    }
+
+    #[test]
+    fn the_last_chair_but_one_counts_the_chair_second_from_the_end() {
+        // Held-out v14 (dev) pb09 and pc04's form: the name between "last" and "but".
+        let said = "stop at the last chair but one; next the table";
+        let plan = |sel: &str| {
+            format!("objects: [(chair, 2, None), (table, None, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{{{sel}}}));\nmove_to_object(get_obj(\"table\"));")
+        };
+        let counted = |f: &[Finding]| {
+            f.iter()
+                .filter(|x| x.to_model.contains("has ordinal -2"))
+                .map(|x| x.about.clone())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(
+            counted(&findings(said, &plan("ordinal: 1"))),
+            [Some(About::Label("chair".into()))]
+        );
+        assert!(counted(&findings(said, &plan("ordinal: -2"))).is_empty());
+        // Said from either end, as "second to last" is.
+        assert_eq!(counts_said(said), [2]);
     }
 
     #[test]
