@@ -2627,6 +2627,27 @@ pub(crate) fn said_in_plural<'a>(names: &'a [String], instruction: &str) -> Vec<
 /// person names that object ([`name_mentions`]). Their labels, once each. "Between the
 /// two red chairs, then the black chair" names the chair again, and "between the sofa
 /// and the two chairs" has no "two" right after "between": neither is one.
+/// The object named first after the one "between" of `instruction` ("between the pink
+/// anchor and the orange buoy": the anchor), past an article and colour words; `None`
+/// where "between" is said more than once or no map object follows it.
+fn first_named_between(map: &IvlMap, instruction: &str, pose: Pose) -> Option<String> {
+    let w = words(instruction);
+    let is_between = |x: &String| matches!(x.as_str(), "between" | "inbetween");
+    let mut at = w
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| is_between(x))
+        .map(|(i, _)| i);
+    let (Some(i), None) = (at.next(), at.next()) else {
+        return None;
+    };
+    let j = match w.get(i + 1).map(String::as_str) {
+        Some("the" | "a" | "an") => i + 1,
+        _ => i,
+    };
+    noun_after(map, &w, j, pose).map(|(_, l)| l)
+}
+
 pub(crate) fn pairs_said_between(map: &IvlMap, instruction: &str, pose: Pose) -> Vec<String> {
     let w = words(instruction);
     let mentions: Vec<Option<String>> = name_mentions(map, &w, pose)
@@ -4581,12 +4602,16 @@ pub fn check_answer_after(
         // "Between the two white folding tables", the one time they are named: the
         // finding is at the picks of that object, and the re-ask's continuation stops
         // between the two there.
+        // "Between the pink anchor and the orange buoy": the finding is at the first
+        // pick of the object named first after "between", so that the re-ask keeps the
+        // steps before it. Held-out v16 (dev) vc10: about no step, the re-ask wrote the
+        // whole plan again and lost the side stop that the steps before had right.
         out.push(
             match pairs_said_between(map, instruction, pose).as_slice() {
                 [label] => f.barring(Bar::PairStop {
                     label: label.clone(),
                 }),
-                _ => f,
+                _ => f.about_label(first_named_between(map, instruction, pose)),
             },
         );
     }
@@ -6738,6 +6763,38 @@ pub(crate) mod tests {
         assert!(counted(&findings(said, &plan("ordinal: -2"))).is_empty());
         // Said from either end, as "second to last" is.
         assert_eq!(counts_said(said), [2]);
+    }
+
+    #[test]
+    fn a_stop_between_two_objects_the_plan_lacks_is_found_at_the_first_of_them() {
+        let between = |said: &str, answer: &str| {
+            findings(said, answer)
+                .into_iter()
+                .find(|x| x.to_model.contains("stops between nothing"))
+                .map(|x| x.about)
+        };
+        // Held-out v16 (dev) vc10's form.
+        let plan = "objects: [(sofa, None, None), (chair, None, black), (tv, None, None)]\nplan:\nmove_to_object(get_obj(\"sofa\"));\nmove_to_object(get_obj(\"chair\", #{colour: \"black\"}));\nmove_to_object(get_obj(\"tv\"));";
+        let said = "go to the sofa, then wait between the black chair and the tv";
+        assert_eq!(
+            between(said, plan),
+            Some(Some(About::Label("chair".into())))
+        );
+        let m = map();
+        let a = parse_answer(plan).unwrap();
+        let f = check_answer(&m, said, &a.tuples, &a.plan, m.start_pose, &[], &[]);
+        assert_eq!(
+            first_disputed_step(&m, said, &f, &a.plan, m.start_pose),
+            Some(1)
+        );
+        // Said twice: no one place.
+        assert_eq!(
+            between(
+                "go between the sofa and the tv, then between the chair and the bed",
+                plan
+            ),
+            Some(None)
+        );
     }
 
     #[test]
