@@ -119,6 +119,11 @@ pub struct PlanOptions {
     /// of one: what `check_unnamed_stops` accepts), where it names any (default on since
     /// stop 82; `--names-anywhere` turns it off).
     pub names_of_said: bool,
+    /// With `said_only`, outside a conversation: where the last thing the instruction
+    /// names is a room, alone in its clause ("..., and wrap up in the medic hut"), the
+    /// plan's last statement is the move into it, unless a move back is asked for
+    /// (default on since stop 82; `--last-room-free` turns it off).
+    pub last_room_stop: bool,
     /// With `said_only`, outside a conversation: a pick may count two or more (either
     /// end) only where the person said a count of its object, in the clause naming it
     /// (default on; `--counts-anywhere` turns it off).
@@ -262,6 +267,7 @@ impl Default for PlanOptions {
             directions_of_said: true,
             regions_of_said: true,
             names_of_said: true,
+            last_room_stop: true,
             counts_of_said: true,
             far_ends_of_said: true,
             side_stops_of_said: false,

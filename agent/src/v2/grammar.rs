@@ -21,6 +21,11 @@ use planner_dsl::ParamType;
 /// [`check::plan_returns`](super::check::plan_returns) counts.
 const RETURN_FUNCTIONS: &[&str] = &["move_to_start", "move_to"];
 
+/// The registry's step functions that leave the robot where it is (it turns, faces or
+/// speaks): what may follow a last stop held by [`Vocabulary::last_stop`] ("..., then
+/// the kitchen and turn around").
+const STILL_FUNCTIONS: &[&str] = &["face", "turn", "turn_absolute", "say"];
+
 /// One tuple of an extraction re-ask's line ([`Vocabulary::held_lines`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum LineHold {
@@ -251,6 +256,12 @@ pub struct Vocabulary {
     /// that no finding disputes. 0 or 1: no such floor, and the grammar is the same as
     /// without the field.
     pub min_steps: usize,
+    /// The plan's last statement must be the move into this room (`move_to_object` of a
+    /// region's name): the last thing the person named, alone in its clause ("..., and
+    /// wrap up in the medic hut"; [`check::last_room_said`](super::check::last_room_said)).
+    /// Not where a move back is required (the grammar then asks for that instead).
+    /// `None`: no such hold, and the grammar is the same as without the field.
+    pub last_stop: Option<String>,
 }
 
 /// A first step the plan must make ([`Vocabulary::first_side`]).
@@ -429,6 +440,7 @@ impl Vocabulary {
             from_start_of: Vec::new(),
             first_side: None,
             min_steps: 0,
+            last_stop: None,
         }
     }
 
@@ -1800,7 +1812,31 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
         vocab.min_steps
     };
     let more = floor.clamp(1, 16) - 1;
-    let stmts = if vocab.return_required {
+    // The last statement held to a move into a room (`last_stop`): it counts toward the
+    // floor, and only steps that leave the robot there (`stillstepn`) follow it.
+    let last = vocab
+        .last_stop
+        .as_ref()
+        .filter(|r| !vocab.return_required && vocab.regions.contains(r));
+    let stmts = if let Some(room) = last {
+        let comment = if vocab.comments {
+            "(comment \"\\n\")? "
+        } else {
+            ""
+        };
+        w.rule(
+            "laststop",
+            &format!(
+                "{comment}{} {} {} (\"\\n\" {comment}stillstepn){{0,3}}",
+                q(&format!("{GOTO_FUNCTION}(")),
+                alt(&[room.as_str()], true),
+                q(");")
+            ),
+        );
+        format!(
+            "(stmtn \"\\n\"){{{more},15}} laststop | (stmtn \"\\n\"){{0,15}} letstmt (\"\\n\" stmt){{0,15}} \"\\n\" laststop"
+        )
+    } else if vocab.return_required {
         format!(
             concat!(
                 "(stmt_nrn \"\\n\"){{{more},15}} retn (\"\\n\" stmtn){{0,15}}",
@@ -1821,7 +1857,9 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
     let stmts = match (&first, vocab.return_required) {
         (None, _) => stmts.clone(),
         (Some(_), true) => format!("firstside \"\\n\" ({stmts})"),
-        (Some(_), false) if vocab.min_steps >= 2 => format!("firstside \"\\n\" ({stmts})"),
+        (Some(_), false) if vocab.min_steps >= 2 || last.is_some() => {
+            format!("firstside \"\\n\" ({stmts})")
+        }
         (Some(_), false) => format!("firstside (\"\\n\" ({stmts}))?"),
     };
     match part {
@@ -1902,6 +1940,10 @@ fn answer(vocab: &Vocabulary, d: Dialect, part: Part) -> String {
             w.rule("stmt", &format!("letstmt | {comment}step"));
         } else {
             w.rule("stmtn", &format!("{comment}stepn"));
+            if last.is_some() {
+                let still: Vec<String> = STILL_FUNCTIONS.iter().filter_map(call).collect();
+                w.rule("stillstepn", &format!("({}) \";\"", still.join(" | ")));
+            }
         }
         if vocab.return_required {
             let rules = |names: &[&str]| -> Vec<String> { names.iter().filter_map(call).collect() };
@@ -2253,6 +2295,14 @@ pub(crate) mod tests {
         used.sort();
         used.dedup();
         used
+    }
+
+    #[test]
+    fn the_steps_that_leave_the_robot_where_it_is_are_registered_ones() {
+        for f in STILL_FUNCTIONS {
+            assert!(STEP_FUNCTIONS.contains(f), "{f}");
+            assert!(!RETURN_FUNCTIONS.contains(f), "{f}");
+        }
     }
 
     #[test]

@@ -448,6 +448,9 @@ fn narrow_to_words(v: &mut Vocabulary, instruction: &str, ctx: &PlanContext<'_>)
         if ctx.options.names_of_said && ctx.earlier.is_none() {
             narrow_names_of_said(v, ctx.map, instruction, ctx.pose());
         }
+        if ctx.options.last_room_stop && ctx.earlier.is_none() {
+            v.last_stop = check::last_room_said(ctx.map, instruction, ctx.pose());
+        }
         if ctx.options.said_colours {
             v.colours_of = Some(colours_said_of(ctx.map, instruction));
         }
@@ -1336,6 +1339,14 @@ fn held_answer(
     // The kept steps hold the first one; the continuation's first step is the stop the
     // plan lacks there, where it is a stop of its own.
     v.first_side = None;
+    // A last room the kept steps already go into, or the one the continuation begins
+    // with, is not asked for again at the end.
+    if let Some(room) = v.last_stop.clone() {
+        let goes = format!("{}(\"{room}\")", grammar::GOTO_FUNCTION);
+        if held.prefix.contains(&goes) || held.first_stop.as_ref() == Some(&room) {
+            v.last_stop = None;
+        }
+    }
     if ctx.options.reask_keeps_steps {
         v.min_steps = held.later;
     }
@@ -1617,13 +1628,16 @@ mod tests {
         narrowed_grammar_with(instruction, |_| {})
     }
 
-    /// [`narrowed_grammar`] with the default options as `set` leaves them.
+    /// [`narrowed_grammar`] with the default options as `set` leaves them, but for the
+    /// last room's stop (`last_room_stop`), off unless `set` turns it on: these
+    /// grammars judge one pick, not where a plan ends.
     fn narrowed_grammar_with(
         instruction: &str,
         set: impl FnOnce(&mut crate::PlanOptions),
     ) -> String {
         let m = map();
         let mut ctx = PlanContext::new(&m);
+        ctx.options.last_room_stop = false;
         set(&mut ctx.options);
         let mut v = Vocabulary::for_map(&m);
         v.map_colours(&m);
@@ -1638,6 +1652,50 @@ mod tests {
 
     fn tuples(line: &str) -> Vec<Tuple> {
         parse_tuples(line).unwrap()
+    }
+
+    #[test]
+    fn a_room_named_last_alone_in_its_clause_is_the_last_stop() {
+        assert_eq!(
+            narrowed(
+                "go to the sofa, then the tv, and wrap up in the kitchen",
+                &[]
+            )
+            .last_stop,
+            Some("kitchen".into())
+        );
+        // Said of an object, said first as where the robot is, or not last: no hold.
+        for said in [
+            "go to the sofa, the one in the kitchen",
+            "the sofa in the kitchen",
+            "go to the kitchen, then the sofa",
+            "come back here after the kitchen, then the tv",
+        ] {
+            assert_eq!(narrowed(said, &[]).last_stop, None, "{said}");
+        }
+        let g = narrowed_grammar_with(
+            "go to the sofa, then the tv, and wrap up in the kitchen",
+            |o| o.last_room_stop = true,
+        );
+        let answer = |plan: &str| {
+            grammar::tests::lark_accepts(
+                &g,
+                &format!("objects: [(sofa, None, None), (tv, None, None), (kitchen, None, None)]\nplan:\n{plan}"),
+            )
+        };
+        let sofa = "move_to_object(get_obj(\"sofa\"));";
+        let tv = "move_to_object(get_obj(\"tv\"));";
+        let kitchen = "move_to_object(\"kitchen\");";
+        assert!(answer(&format!("{sofa}\n{tv}\n{kitchen}")).is_ok());
+        assert!(answer(&format!("{sofa}\n{tv}")).is_err());
+        assert!(answer(&format!("{sofa}\n{tv}\n{kitchen}\n{tv}")).is_err());
+        // Turns and faces may follow it ("then the kitchen and turn around").
+        assert!(answer(&format!("{sofa}\n{tv}\n{kitchen}\nturn(180);")).is_ok());
+        // A move back asked for holds the end instead.
+        let mut v = narrowed("go to the sofa, then the kitchen, then come back here", &[]);
+        assert_eq!(v.last_stop.as_deref(), Some("kitchen"));
+        v.return_required = true;
+        assert!(!answer_lark(&v).contains("laststop"));
     }
 
     #[test]
