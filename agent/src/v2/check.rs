@@ -1065,6 +1065,43 @@ pub(crate) fn colour_said_only_of(
     }
 }
 
+/// Picks that keep a colour the person said only to exclude it ("a non-yellow skate
+/// trainer", "the sofa that isn't red" written `colour: "yellow"`, `colour: "red"`):
+/// [`colour_mentions_excluded`], every mention of that colour after a word that
+/// excludes. The colour checks take `colour` and `not_colour` alike as carrying a said
+/// colour, so none saw it: held-out v17 (dev) wb09.
+fn check_excluded_colours_kept(
+    map: &IvlMap,
+    instruction: &str,
+    plan: &TypedPlan,
+    pose: Pose,
+) -> Vec<Finding> {
+    let mentions = colour_mentions_excluded(map, instruction, pose);
+    let mut out: Vec<Finding> = Vec::new();
+    for t in targets(plan) {
+        let Some(c) = t.colour.as_deref() else {
+            continue;
+        };
+        let of: Vec<&(String, Option<String>, bool)> = mentions
+            .iter()
+            .filter(|(x, _, _)| same_colour(Some(x), c))
+            .collect();
+        if of.is_empty() || !of.iter().all(|(_, _, excluded)| *excluded) {
+            continue;
+        }
+        let f = Finding::new(
+            FindingKind::Word,
+            format!("the person said {c} only to exclude it, but the plan picks the {} with colour: \"{c}\": write not_colour: \"{c}\" there", t.name),
+            format!("do you mean a {} that is not {c}?", t.name),
+        )
+        .about_label(object_label(map, &t.name, pose));
+        if !out.contains(&f) {
+            out.push(f);
+        }
+    }
+    out
+}
+
 /// Each colour word of the instruction as [`colour_mentions`] reads it (over the whole
 /// instruction: "the ironing board, the white one" says white of the ironing board
 /// across the comma), and whether a word that excludes ([`excludes`]) comes before it in
@@ -2758,6 +2795,9 @@ fn plan_stops_between(plan: &TypedPlan) -> bool {
 const EXCLUDING: &[&str] = &[
     "not",
     "no",
+    // "a non-yellow skate trainer" (held-out v17, dev, wb09: planned `colour: "yellow"`,
+    // and no check saw it).
+    "non",
     "except",
     "excluding",
     "without",
@@ -2869,7 +2909,17 @@ pub(crate) fn size_said(instruction: &str, name_words: Option<&[String]>) -> boo
     if superlative_unread(instruction) {
         return true;
     }
-    let w = words(instruction);
+    // Within a sentence (split at ".", ":", ";", "!", "?", not at commas: "the big,
+    // black sofa"): "Robot, little list: the slalom pole right at the west end, ..."
+    // says no size (held-out v17, dev, wb02: offered orders by size, the default model
+    // counted every pick smallest first).
+    instruction
+        .split(['.', ':', ';', '!', '?'])
+        .any(|s| size_said_in(&words(s), name_words))
+}
+
+/// [`size_said`] in the words `w` of one sentence.
+fn size_said_in(w: &[String], name_words: Option<&[String]>) -> bool {
     w.iter().enumerate().any(|(i, x)| {
         let Some(stem) = SIZE_STEMS.iter().find(|s| x.starts_with(*s)) else {
             return false;
@@ -4596,6 +4646,7 @@ pub fn check_answer_after(
     out.extend(check_visits(map, instruction, pose, visited, refs));
     out.extend(check_anchor_stops(map, instruction, plan, pose));
     out.extend(check_side_moves(map, instruction, plan, pose));
+    out.extend(check_excluded_colours_kept(map, instruction, plan, pose));
     if refs.is_empty() && earlier.is_none() {
         out.extend(check_unnamed_stops(map, instruction, plan, pose));
         out.extend(check_names_said_again(map, instruction, plan, pose));
@@ -5802,9 +5853,40 @@ pub(crate) mod tests {
             "go to the sofa, not the red sofa",
             "go to a sofa other than the red sofa",
             "go to the sofa that isn't red",
+            // Held-out v17 (dev) wb09's form.
+            "go to a non-red sofa",
         ] {
             assert_no_finding(said, "sofa", "#{not_colour: \"red\"}", "has colour \"red\"");
         }
+        let m = map();
+        let a = parse_answer("objects: [(sofa, None, red)]\nplan:\nmove_to_object(get_obj(\"sofa\", #{colour: \"red\"}));").unwrap();
+        let f = check_answer(
+            &m,
+            "go to a non-red sofa",
+            &a.tuples,
+            &a.plan,
+            m.start_pose,
+            &[],
+            &[],
+        );
+        assert!(
+            f.iter().any(|x| x.to_model.contains("only to exclude it")),
+            "a non-red sofa written red: {f:?}"
+        );
+        // Said kept elsewhere: the red sofa may be a stop of its own.
+        let f = check_answer(
+            &m,
+            "go to the red sofa, then a chair that isn't red",
+            &a.tuples,
+            &a.plan,
+            m.start_pose,
+            &[],
+            &[],
+        );
+        assert!(
+            f.iter().all(|x| !x.to_model.contains("only to exclude it")),
+            "{f:?}"
+        );
     }
 
     #[test]
@@ -5910,6 +5992,11 @@ pub(crate) mod tests {
             assert!(!said(s), "{s}");
             assert!(size_said(s, None), "{s}");
         }
+        // Held-out v17 (dev) wb02: a sentence ends before the name; a comma does not.
+        assert!(!said(
+            "Robot, little list: the booth seat right at the west end"
+        ));
+        assert!(said("the big, red table"));
         let a = parse_answer("objects: [(chair, 2, None)]\nplan:\nmove_to_object(get_obj(\"chair\", #{ordinal: 2, order: \"smallest_to_largest\"}));").unwrap();
         let plan = &a.plan;
         let names = object_name_words(&map());
