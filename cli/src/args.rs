@@ -298,11 +298,11 @@ pub(crate) struct ModelArgs {
     /// object nobody named).
     #[arg(long)]
     pub(crate) names_anywhere: bool,
-    /// Hold a plan's last statement to the move into the room the instruction names
-    /// last, alone in its clause ("..., and wrap up in the medic hut"); off by default
-    /// (the checks re-ask a plan that never goes into it).
+    /// Let a plan end anywhere where the instruction names a room last, alone in its
+    /// clause (the default before stop 82; for comparison; the checks then re-ask a
+    /// plan that never goes into it).
     #[arg(long)]
-    pub(crate) last_room_stop: bool,
+    pub(crate) last_room_free: bool,
     /// Let a pick of any object count two or more wherever the instruction says such a
     /// count, not only one whose clause says it (the default before stop 64; for
     /// comparison).
@@ -448,7 +448,7 @@ impl ModelArgs {
             directions_of_said: !self.directions_anywhere,
             regions_of_said: self.regions_of_said || !self.regions_anywhere,
             names_of_said: !self.names_anywhere,
-            last_room_stop: self.last_room_stop,
+            last_room_stop: !self.last_room_free,
             counts_of_said: !self.counts_anywhere,
             far_ends_of_said: !self.far_end_anywhere,
             side_stops_of_said: self.side_stops_barred,

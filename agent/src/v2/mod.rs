@@ -1656,18 +1656,14 @@ mod tests {
 
     #[test]
     fn a_room_named_last_alone_in_its_clause_is_the_last_stop() {
-        // With `last_room_stop` on (off by default: no hold).
-        let narrowed = |said: &str, _: &[u32]| {
-            let m = map();
-            let mut ctx = PlanContext::new(&m);
-            ctx.options.last_room_stop = true;
-            let mut v = Vocabulary::for_map(&m);
-            narrow_to_words(&mut v, said, &ctx);
-            v
-        };
-        let said = "go to the sofa, then the tv, and wrap up in the kitchen";
-        assert_eq!(narrowed(said, &[]).last_stop, Some("kitchen".into()));
-        assert_eq!(super::tests::narrowed(said, &[]).last_stop, None);
+        assert_eq!(
+            narrowed(
+                "go to the sofa, then the tv, and wrap up in the kitchen",
+                &[]
+            )
+            .last_stop,
+            Some("kitchen".into())
+        );
         // Said of an object, said first as where the robot is, or not last: no hold.
         for said in [
             "go to the sofa, the one in the kitchen",
