@@ -553,6 +553,10 @@ fn check_listed_counts_unplanned(
             continue;
         };
         let name_words: Vec<&str> = label.split(' ').collect();
+        let of_label: Vec<&Target> = targets(plan)
+            .into_iter()
+            .filter(|t| picks(map, pose, label)(t))
+            .collect();
         let mut i = 0;
         while i < c.len() {
             let x = &c[i];
@@ -564,15 +568,13 @@ fn check_listed_counts_unplanned(
             if matches!(prev, "the" | "number" | "no" | "#") || name_words.contains(&x.as_str()) {
                 continue;
             }
-            let ordinal_form =
-                ["st", "nd", "rd", "th"].iter().any(|e| x.ends_with(e)) || x == "second";
             let k = match (phrase, x.as_str()) {
                 (Some((k, _)), _) => Some(k),
                 (None, "last") => (start + 1 < c.len()).then_some(-1),
                 _ => parse_ordinal(x)
                     .ok()
                     .flatten()
-                    .filter(|_| ordinal_form)
+                    .filter(|_| in_ordinal_form(x))
                     .or_else(|| said_count(x).filter(|&k| k == -2)),
             };
             let Some(k) = k.filter(|&k| k != 0 && k != 1) else {
@@ -592,25 +594,10 @@ fn check_listed_counts_unplanned(
                 (t.ordinal == Some(k) || from_other_end(t))
                     && object_label(map, &t.object, pose).as_deref() == Some(label)
             });
-            let of_label: Vec<&Target> = targets(plan)
-                .into_iter()
-                .filter(|t| picks(map, pose, label)(t))
-                .collect();
-            let counts = |t: &&Target| {
-                if k < 0 {
-                    t.ordinal == k || (t.ordinal == -k && t.order != ObjectOrder::NearToFar)
-                } else {
-                    t.ordinal.abs() == k
-                }
-            };
-            if !listed || of_label.is_empty() || of_label.iter().any(counts) {
+            if !listed || of_label.is_empty() || of_label.iter().any(|t| counts_as_said(t, k)) {
                 continue;
             }
-            let wanted = if k < 0 {
-                format!("{k} (or {} counted from the other end)", -k)
-            } else {
-                k.to_string()
-            };
+            let wanted = ordinal_wanted(k);
             let f = Finding::new(
                 FindingKind::Word,
                 format!("the person said \"{}\", and the objects line counts the {label} {k}, but no {label} in the plan has ordinal {wanted}", c.join(" ")),
@@ -623,6 +610,33 @@ fn check_listed_counts_unplanned(
         }
     }
     out
+}
+
+/// Whether `word` is a count in an ordinal form ("third", "3rd", "second"), not a
+/// bare number ("the two tables" counts nothing).
+fn in_ordinal_form(word: &str) -> bool {
+    ["st", "nd", "rd", "th"].iter().any(|e| word.ends_with(e)) || word == "second"
+}
+
+/// Whether target `t` counts as the person's count `k`: k-th (either end where `k` is
+/// positive), or from the end (`-k`, or `k` counted from the other end of an order the
+/// person gave), or the k-th visited ("the second chair you visited").
+fn counts_as_said(t: &Target, k: i64) -> bool {
+    if k < 0 {
+        t.ordinal == k || t.visited == k || (t.ordinal == -k && t.order != ObjectOrder::NearToFar)
+    } else {
+        t.ordinal.abs() == k || t.visited == k
+    }
+}
+
+/// The ordinal a re-ask asks for after the count `k`: "-2 (or 2 counted from the other
+/// end)", or "3".
+fn ordinal_wanted(k: i64) -> String {
+    if k < 0 {
+        format!("{k} (or {} counted from the other end)", -k)
+    } else {
+        k.to_string()
+    }
 }
 
 /// The article before `word`: "an" before a vowel ("an ironing board"), else "a".
@@ -1631,11 +1645,7 @@ fn check_words(
             if let Some(k) = k {
                 // "the two tables" counts nothing: after "the", only ordinal forms
                 // ("third", "3rd", "last"); after "number", any number.
-                let ordinal_form = ["st", "nd", "rd", "th"].iter().any(|x| word.ends_with(x))
-                    || word == "last"
-                    || word == "second"
-                    || k == -2
-                    || to_last;
+                let ordinal_form = in_ordinal_form(word) || word == "last" || k == -2 || to_last;
                 if (!matches!(prev, "number" | "no" | "#") && !ordinal_form) || k == 1 || k == 0 {
                     continue;
                 }
@@ -1646,20 +1656,8 @@ fn check_words(
                 // From the end ("last", "penultimate"): -k, or k counted from the other
                 // end of an order the person gave.
                 // "The second chair you visited" counts the visits (`visited: 2`).
-                let counts = |t: &Target| {
-                    if k < 0 {
-                        t.ordinal == k
-                            || t.visited == k
-                            || (t.ordinal == -k && t.order != ObjectOrder::NearToFar)
-                    } else {
-                        t.ordinal.abs() == k || t.visited == k
-                    }
-                };
-                let wanted = if k < 0 {
-                    format!("{k} (or {} counted from the other end)", -k)
-                } else {
-                    k.to_string()
-                };
+                let counts = |t: &Target| counts_as_said(t, k);
+                let wanted = ordinal_wanted(k);
                 // The object the count is said of ("the second chair"), when its name
                 // follows, or, after "number", comes right before ("chair number 3,
                 // then the plant": held-out v4 (dev) hk05 read the plant as counted):
@@ -2681,18 +2679,20 @@ pub(crate) fn said_in_plural<'a>(names: &'a [String], instruction: &str) -> Vec<
 /// 42 first answers left out such a last room (most went on with steps nobody asked for,
 /// the same stop again and again) and were re-asked; wb02, wb08 and wc08 were lost.
 pub(crate) fn last_room_said(map: &IvlMap, instruction: &str, pose: Pose) -> Option<String> {
-    let all = name_mentions(map, &words(instruction), pose);
-    let parts = clauses(instruction);
-    let c = parts
-        .iter()
+    let w = words(instruction);
+    let (c, said) = clauses(instruction)
+        .into_iter()
         .rev()
-        .find(|c| !name_mentions(map, c, pose).is_empty())?;
-    let said = name_mentions(map, c, pose);
+        .map(|c| {
+            let said = name_mentions(map, &c, pose);
+            (c, said)
+        })
+        .find(|(_, said)| !said.is_empty())?;
     let [(_, room)] = said.as_slice() else {
         return None;
     };
     let alone_start =
-        all.len() == 1 && start_room_named_first(map, &words(instruction), pose).is_some();
+        name_mentions(map, &w, pose).len() == 1 && start_room_named_first(map, &w, pose).is_some();
     let is_room = is_region(map, room) && !map.instances.iter().any(|i| i.label == *room);
     (is_room && !alone_start && !c.iter().any(|x| matches!(x.as_str(), "one" | "ones")))
         .then(|| room.clone())
